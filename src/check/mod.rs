@@ -1,0 +1,1 @@
+//! Geometric checks on evaluated designs: self-intersection, obstacles, verification.

@@ -1,0 +1,21 @@
+//! The command-line interface: one file per subcommand; `main.rs` only dispatches.
+
+use clap::{Parser, Subcommand};
+
+/// foldsynth: synthesize rigidly foldable origami crease patterns.
+#[derive(Debug, Parser)]
+#[command(name = "foldsynth", version, about)]
+pub struct Cli {
+    /// The subcommand to run.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {}
+
+/// Run one parsed command line.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {}
+}

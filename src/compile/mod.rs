@@ -1,0 +1,1 @@
+//! The compiler: egg simplification, reverse-mode differentiation, Cranelift JIT.

@@ -1,0 +1,1 @@
+//! Files people open: FOLD, SVG, OBJ/STL, pictures, animations, plots, report.

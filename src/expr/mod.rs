@@ -1,0 +1,1 @@
+//! The hash-consed expression DAG that implements `Scalar` symbolically.

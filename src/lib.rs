@@ -1,0 +1,21 @@
+//! foldsynth: synthesis of rigidly foldable origami crease patterns.
+//!
+//! The data flows one way (see `ARCHITECTURE.md`):
+//! task → grammar → model → compile → optimize → check → search → export,
+//! with [`kinematics`] (the Principle of Three Units, generic over [`kinematics::Scalar`])
+//! and [`expr`] (the expression graph) underneath, and [`simulate`] as the numeric
+//! bar-and-hinge baseline of thesis Sec. 3.
+
+pub mod check;
+pub mod cli;
+pub mod compile;
+pub mod export;
+pub mod expr;
+pub mod grammar;
+pub mod kinematics;
+pub mod model;
+pub mod optimize;
+pub mod pattern;
+pub mod search;
+pub mod simulate;
+pub mod task;

@@ -1,0 +1,1 @@
+//! Bounded, constrained, multi-start gradient optimization (augmented Lagrangian + L-BFGS).

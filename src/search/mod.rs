@@ -1,0 +1,1 @@
+//! Enumeration of design alternatives: graphs × rigid body modes × gripping candidates.

@@ -1,0 +1,1 @@
+//! Design task files (`grammar/*.toml`): parsing and validation.
