@@ -6,6 +6,8 @@
 //! and [`expr`] (the expression graph) underneath, and [`simulate`] as the numeric
 //! bar-and-hinge baseline of thesis Sec. 3.
 
+#![warn(missing_docs)]
+
 pub mod check;
 pub mod cli;
 pub mod compile;
