@@ -2,6 +2,8 @@
 
 use clap::{Parser, Subcommand};
 
+pub mod enumerate;
+
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
 #[derive(Debug, Parser)]
 #[command(name = "foldsynth", version, about)]
@@ -13,9 +15,14 @@ pub struct Cli {
 
 /// The subcommands.
 #[derive(Debug, Subcommand)]
-pub enum Command {}
+pub enum Command {
+    /// Generate every crease pattern graph of a task (rules r1, r2; thesis Table 3).
+    Enumerate(enumerate::EnumerateArgs),
+}
 
 /// Run one parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
-    match cli.command {}
+    match cli.command {
+        Command::Enumerate(args) => enumerate::run(args),
+    }
 }
