@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod enumerate;
+pub mod vertex;
 
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
 #[derive(Debug, Parser)]
@@ -16,6 +17,8 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// The PTU for one vertex: unit, internal, start/end and dihedral angles over t.
+    Vertex(vertex::VertexArgs),
     /// Generate every crease pattern graph of a task (rules r1, r2; thesis Table 3).
     Enumerate(enumerate::EnumerateArgs),
 }
@@ -23,6 +26,7 @@ pub enum Command {
 /// Run one parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Command::Vertex(a) => vertex::run(a),
         Command::Enumerate(args) => enumerate::run(args),
     }
 }

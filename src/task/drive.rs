@@ -2,44 +2,62 @@
 
 use std::fmt;
 
-use serde::{Deserialize, Serialize};
+use crate::kinematics::{DriveExpr, Scalar};
 
-use super::number::Expr;
-
-/// A driving-angle expression in the driving parameter `t`, checked on load.
-///
-/// The text is kept as written: the kinematics module's expression type evaluates it (for
-/// `f64` and for symbols); this newtype only guarantees it parses.
-#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(transparent)]
-pub struct Drive(String);
+/// A driving-angle expression in the driving parameter `t`, parsed on load by the
+/// kinematics module's [`DriveExpr`], with the text as written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Drive {
+    text: String,
+    expr: DriveExpr,
+}
 
 impl Drive {
-    /// Check `text` and wrap it. Errors say what is allowed.
+    /// Parse `text`. Errors say what is allowed.
     pub fn parse(text: &str) -> Result<Drive, String> {
-        let e = Expr::parse(text, true)?;
-        if !e.uses_t() {
+        let expr = DriveExpr::parse(text).map_err(|e| {
+            format!("\"{text}\" is not a driving-angle expression: {}", e.message)
+        })?;
+        if !uses_t(&expr) {
             return Err(format!(
-                "\"{text}\" does not use the driving parameter `t`; a driven crease must move with t (e.g. \"t\", \"-t\", \"t/1.2\")"
+                "\"{text}\" does not use the driving parameter `t`; a driven crease moves with t (e.g. \"t\", \"-t\", \"t/1.2\")"
             ));
         }
-        Ok(Drive(text.trim().to_owned()))
+        Ok(Drive {
+            text: text.trim().to_owned(),
+            expr,
+        })
     }
 
     /// The expression as written.
     pub fn as_str(&self) -> &str {
-        &self.0
+        &self.text
     }
 
-    /// The driving angle at parameter `t` (a plain-f64 convenience for checks and tests).
-    pub fn eval(&self, t: f64) -> f64 {
-        // Parsed once on construction, so this cannot fail.
-        Expr::parse(&self.0, true).map_or(f64::NAN, |e| e.eval(t))
+    /// The parsed expression.
+    pub fn expr(&self) -> &DriveExpr {
+        &self.expr
+    }
+
+    /// The driving angle at parameter `t`, in any [`Scalar`].
+    pub fn eval<S: Scalar>(&self, t: &S) -> S {
+        self.expr.eval(t)
+    }
+}
+
+fn uses_t(e: &DriveExpr) -> bool {
+    match e {
+        DriveExpr::Num(_) => false,
+        DriveExpr::T => true,
+        DriveExpr::Neg(a) => uses_t(a),
+        DriveExpr::Add(a, b) | DriveExpr::Sub(a, b) | DriveExpr::Mul(a, b) | DriveExpr::Div(a, b) => {
+            uses_t(a) || uses_t(b)
+        }
     }
 }
 
 impl fmt::Display for Drive {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
+        f.write_str(&self.text)
     }
 }

@@ -2,9 +2,8 @@
 //! `"17*pi/18"` or `"1 + 2*cos(pi/20)"`.
 //!
 //! Angles like π/18 are exact in the thesis; writing them as expressions keeps the task
-//! files readable and free of truncated decimals. The same parser checks driving-angle
-//! expressions (which may use the driving parameter `t`) until the kinematics module's
-//! `DriveExpr` takes over.
+//! files readable and free of truncated decimals. (Driving angles, which use `t`, are
+//! parsed by the kinematics module's `DriveExpr`.)
 
 use std::fmt;
 
@@ -25,7 +24,7 @@ impl Number {
     pub fn value(&self) -> Result<f64, String> {
         match self {
             Number::Literal(v) => Ok(*v),
-            Number::Expr(s) => Ok(Expr::parse(s, false)?.eval(0.0)),
+            Number::Expr(s) => Ok(Expr::parse(s)?.eval()),
         }
     }
 }
@@ -73,13 +72,11 @@ impl<'de> Deserialize<'de> for Number {
     }
 }
 
-/// A parsed arithmetic expression, optionally in the driving parameter `t`.
+/// A parsed constant arithmetic expression.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Expr {
     /// A constant.
     Const(f64),
-    /// The driving parameter `t`.
-    T,
     /// Negation.
     Neg(Box<Expr>),
     /// A binary operation: one of `+ - * / ^`.
@@ -89,13 +86,9 @@ pub enum Expr {
 }
 
 impl Expr {
-    /// Parse `s`; `allow_t` admits the driving parameter `t`.
-    pub fn parse(s: &str, allow_t: bool) -> Result<Expr, String> {
-        let mut p = Parser {
-            src: s,
-            pos: 0,
-            allow_t,
-        };
+    /// Parse `s`.
+    pub fn parse(s: &str) -> Result<Expr, String> {
+        let mut p = Parser { src: s, pos: 0 };
         p.skip_ws();
         if p.pos == s.len() {
             return Err("empty expression".into());
@@ -112,14 +105,13 @@ impl Expr {
         Ok(e)
     }
 
-    /// Evaluate at driving parameter `t`.
-    pub fn eval(&self, t: f64) -> f64 {
+    /// The value.
+    pub fn eval(&self) -> f64 {
         match self {
             Expr::Const(c) => *c,
-            Expr::T => t,
-            Expr::Neg(a) => -a.eval(t),
+            Expr::Neg(a) => -a.eval(),
             Expr::Bin(op, a, b) => {
-                let (a, b) = (a.eval(t), b.eval(t));
+                let (a, b) = (a.eval(), b.eval());
                 match op {
                     '+' => a + b,
                     '-' => a - b,
@@ -129,7 +121,7 @@ impl Expr {
                 }
             }
             Expr::Call(f, a) => {
-                let a = a.eval(t);
+                let a = a.eval();
                 match *f {
                     "sin" => a.sin(),
                     "cos" => a.cos(),
@@ -138,22 +130,11 @@ impl Expr {
             }
         }
     }
-
-    /// Whether the expression mentions `t`.
-    pub fn uses_t(&self) -> bool {
-        match self {
-            Expr::Const(_) => false,
-            Expr::T => true,
-            Expr::Neg(a) | Expr::Call(_, a) => a.uses_t(),
-            Expr::Bin(_, a, b) => a.uses_t() || b.uses_t(),
-        }
-    }
 }
 
 struct Parser<'a> {
     src: &'a str,
     pos: usize,
-    allow_t: bool,
 }
 
 impl Parser<'_> {
@@ -245,7 +226,6 @@ impl Parser<'_> {
                 self.pos += end;
                 match word {
                     "pi" | "PI" | "Pi" => Ok(Expr::Const(std::f64::consts::PI)),
-                    "t" if self.allow_t => Ok(Expr::T),
                     "sin" | "cos" | "sqrt" => {
                         let name: &'static str = match word {
                             "sin" => "sin",
@@ -258,8 +238,7 @@ impl Parser<'_> {
                         Ok(Expr::Call(name, Box::new(self.atom()?)))
                     }
                     _ => Err(format!(
-                        "unknown name `{word}` (allowed: numbers, pi{}, sin, cos, sqrt, + - * / ^, parentheses)",
-                        if self.allow_t { ", t" } else { "" }
+                        "unknown name `{word}` (allowed: numbers, pi, sin, cos, sqrt, + - * / ^, parentheses)"
                     )),
                 }
             }
@@ -280,7 +259,7 @@ mod tests {
 
     #[test]
     fn evaluates_thesis_constants() {
-        let v = |s: &str| Expr::parse(s, false).unwrap().eval(0.0);
+        let v = |s: &str| Expr::parse(s).unwrap().eval();
         assert_eq!(v("pi/18"), PI / 18.0);
         assert_eq!(v("17*pi/18"), 17.0 * PI / 18.0);
         assert_eq!(v("1 + 2*cos(pi/20)"), 1.0 + 2.0 * (PI / 20.0).cos());
@@ -291,17 +270,9 @@ mod tests {
     }
 
     #[test]
-    fn t_only_where_allowed() {
-        assert!(Expr::parse("t/1.2", false).is_err());
-        let e = Expr::parse("-t/1.2", true).unwrap();
-        assert!(e.uses_t());
-        assert_eq!(e.eval(1.2), -1.0);
-    }
-
-    #[test]
     fn rejects_garbage() {
-        for s in ["", "pi/", "(1", "2 3", "foo", "sin 1", "1..2"] {
-            assert!(Expr::parse(s, true).is_err(), "{s}");
+        for s in ["", "pi/", "(1", "2 3", "foo", "t", "sin 1", "1..2"] {
+            assert!(Expr::parse(s).is_err(), "{s}");
         }
     }
 }
