@@ -9,6 +9,10 @@ use serde::Serialize;
 use crate::grammar::{Enumeration, Filters, Status};
 use crate::task::{N_MAX_LIMIT, Task};
 
+/// Graph budget: every generated graph is kept (about 10 kB each), so this bounds memory
+/// to about 3 GB. Without the isomorphism filter N_max = 5 exceeds it.
+const MAX_GRAPHS: usize = 200_000;
+
 /// Output format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
@@ -82,7 +86,7 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
         mirror: !args.no_mirror,
         validity: !args.no_validity,
     };
-    let e = Enumeration::run(&task, n_max, filters);
+    let e = Enumeration::run_limited(&task, n_max, filters, MAX_GRAPHS)?;
     if let Some(path) = &args.tree {
         std::fs::write(path, e.to_dot())
             .with_context(|| format!("cannot write the search tree to {}", path.display()))?;
@@ -128,7 +132,13 @@ fn on(b: bool) -> &'static str {
 fn text_report(task: &Task, e: &Enumeration, args: &EnumerateArgs) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
-    let _ = writeln!(s, "task: {} ({}), N_max = {}", task.name, args.task.display(), e.n_max);
+    let _ = writeln!(
+        s,
+        "task: {} ({}), N_max = {}",
+        task.name,
+        args.task.display(),
+        e.n_max
+    );
     let mirror = if e.filters.mirror && !e.mirror_applied {
         "off (task not mirror-symmetric)"
     } else {
@@ -142,7 +152,10 @@ fn text_report(task: &Task, e: &Enumeration, args: &EnumerateArgs) -> String {
         on(e.filters.validity)
     );
     let _ = writeln!(s);
-    let _ = writeln!(s, "level  generated  isomorphic  mirror  invalid  meaningful");
+    let _ = writeln!(
+        s,
+        "level  generated  isomorphic  mirror  invalid  meaningful"
+    );
     let mut total = crate::grammar::LevelCounts::default();
     for c in e.level_counts() {
         let _ = writeln!(

@@ -38,11 +38,19 @@ pub struct Filters {
 impl Filters {
     /// Every filter on (the thesis's setting).
     pub fn all() -> Filters {
-        Filters { isomorphism: true, mirror: true, validity: true }
+        Filters {
+            isomorphism: true,
+            mirror: true,
+            validity: true,
+        }
     }
     /// No filter: the raw language of the grammar.
     pub fn none() -> Filters {
-        Filters { isomorphism: false, mirror: false, validity: false }
+        Filters {
+            isomorphism: false,
+            mirror: false,
+            validity: false,
+        }
     }
 }
 
@@ -117,9 +125,37 @@ pub struct Enumeration {
     pub mirror_applied: bool,
 }
 
+/// The search tree grew past the graph budget given to [`Enumeration::run_limited`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "the search tree exceeded {limit} graphs at level {level} (N_max = {n_max}); switch the isomorphism filter on or lower N_max"
+)]
+pub struct TooLarge {
+    /// The budget.
+    pub limit: usize,
+    /// The level being generated.
+    pub level: usize,
+    /// The N_max requested.
+    pub n_max: usize,
+}
+
 impl Enumeration {
     /// Enumerate all graphs of `task` up to `n_max` internal vertices.
     pub fn run(task: &Task, n_max: usize, filters: Filters) -> Enumeration {
+        match Self::run_limited(task, n_max, filters, usize::MAX) {
+            Ok(e) => e,
+            Err(e) => unreachable!("no budget, yet {e}"),
+        }
+    }
+
+    /// As [`Enumeration::run`], but give up once more than `max_graphs` graphs are
+    /// generated (every graph is kept in memory, about 10 kB each).
+    pub fn run_limited(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        max_graphs: usize,
+    ) -> Result<Enumeration, TooLarge> {
         let root = CreaseGraph::initial(task);
         let mirror_applied =
             filters.mirror && task.symmetry.mirror_xz && root.initial_graph().mirror.is_some();
@@ -145,6 +181,13 @@ impl Enumeration {
                     c.combine(m).expect("r2 matches what r2_matches found");
                     children.push(c);
                 }
+                if nodes.len() + children.len() > max_graphs {
+                    return Err(TooLarge {
+                        limit: max_graphs,
+                        level,
+                        n_max,
+                    });
+                }
                 for graph in children {
                     let code = graph.canonical_code();
                     let status = if filters.isomorphism && !seen.insert(code.clone()) {
@@ -166,18 +209,31 @@ impl Enumeration {
                     if matches!(status, Status::Meaningful | Status::Invalid) {
                         next.push(Some(nodes.len()));
                     }
-                    nodes.push(Node { graph, parent, level, status });
+                    nodes.push(Node {
+                        graph,
+                        parent,
+                        level,
+                        status,
+                    });
                 }
             }
             frontier = next;
         }
-        Enumeration { root, nodes, n_max, filters, mirror_applied }
+        Ok(Enumeration {
+            root,
+            nodes,
+            n_max,
+            filters,
+            mirror_applied,
+        })
     }
 
     /// The generated graph with this rule sequence, if it was generated.
     pub fn find(&self, sequence: &str) -> Option<&Node> {
         let steps = parse_sequence(sequence).ok()?;
-        self.nodes.iter().find(|n| n.graph.sequence_steps() == steps)
+        self.nodes
+            .iter()
+            .find(|n| n.graph.sequence_steps() == steps)
     }
 
     /// The meaningful graphs, in generation order.
@@ -199,7 +255,10 @@ impl Enumeration {
     pub fn level_counts(&self) -> Vec<LevelCounts> {
         let depth = self.nodes.iter().map(|n| n.level).max().unwrap_or(0);
         let mut out: Vec<LevelCounts> = (1..=depth)
-            .map(|level| LevelCounts { level, ..LevelCounts::default() })
+            .map(|level| LevelCounts {
+                level,
+                ..LevelCounts::default()
+            })
             .collect();
         for n in &self.nodes {
             let c = &mut out[n.level - 1];
@@ -219,9 +278,16 @@ impl Enumeration {
     pub fn to_dot(&self) -> String {
         let mut s = String::new();
         let _ = writeln!(s, "digraph search_tree {{");
-        let _ = writeln!(s, "  // foldsynth enumerate: N_max = {}; meaningful = yellow, invalid = white, mirror = grey, isomorphic = blue", self.n_max);
+        let _ = writeln!(
+            s,
+            "  // foldsynth enumerate: N_max = {}; meaningful = yellow, invalid = white, mirror = grey, isomorphic = blue",
+            self.n_max
+        );
         let _ = writeln!(s, "  graph [rankdir=TB, ranksep=0.8, nodesep=0.1];");
-        let _ = writeln!(s, "  node [shape=box, style=\"filled,rounded\", fontname=\"Helvetica\", fontsize=10];");
+        let _ = writeln!(
+            s,
+            "  node [shape=box, style=\"filled,rounded\", fontname=\"Helvetica\", fontsize=10];"
+        );
         let _ = writeln!(s, "  g0 [label=\"G0\", fillcolor=\"#dddddd\"];");
         for (i, n) in self.nodes.iter().enumerate() {
             let color = match n.status {

@@ -127,6 +127,22 @@ impl CreaseGraph {
         &self.g
     }
 
+    /// A compact copy for petgraph algorithms that need contiguous indices (isomorphism,
+    /// matrices): node `i` is the vertex named `i + 1`, weights are the stable ids.
+    pub fn compact_digraph(&self) -> petgraph::graph::DiGraph<Vid, Cid> {
+        let mut d = petgraph::graph::DiGraph::with_capacity(self.order.len(), self.edge_of.len());
+        let mut ix = vec![None; self.node_of.len()];
+        for &v in &self.order {
+            ix[v.ix()] = Some(d.add_node(v));
+        }
+        for c in self.creases() {
+            if let (Some(a), Some(b)) = (ix[c.tail.ix()], ix[c.head.ix()]) {
+                d.add_edge(a, b, c.cid);
+            }
+        }
+        d
+    }
+
     /// The petgraph node of a living vertex.
     pub fn node_index(&self, v: Vid) -> Option<NodeIndex> {
         self.node_of.get(v.ix()).copied().flatten()
@@ -344,8 +360,7 @@ impl CreaseGraph {
     pub fn facet_boundaries(&self) -> Result<Vec<FacetBoundary>, FacetError> {
         // A dart (v, k): ray k at v, with its facet counter-clockwise of it; walking along
         // the crease away from v keeps that facet on the left.
-        let rings: Vec<(Vid, Vec<Ray>)> =
-            self.vertices().map(|v| (v.vid, self.ring(v))).collect();
+        let rings: Vec<(Vid, Vec<Ray>)> = self.vertices().map(|v| (v.vid, self.ring(v))).collect();
         let pos_of = |v: Vid| rings.iter().position(|(u, _)| *u == v).expect("living");
         let vname = |v: Vid| format!("v{}", self.name(v).unwrap_or(0));
         // Labels must agree across every closed sector.
@@ -385,7 +400,10 @@ impl CreaseGraph {
             let j = pos_of(w);
             let wr = &rings[j].1;
             let m = wr.len();
-            let at = wr.iter().position(|r| r.cid == c).expect("crease in both rings");
+            let at = wr
+                .iter()
+                .position(|r| r.cid == c)
+                .expect("crease in both rings");
             let prev = (at + m - 1) % m;
             if wr[prev].closed_after {
                 let e = dart_ix(j, prev);

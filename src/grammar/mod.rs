@@ -37,6 +37,36 @@
 //! [`StepRecord`] with the constraints they add ([`ConstraintSpec`], Eq. 31–34) and, for r2,
 //! the variables it eliminates and their geometric substitutes (Eq. 35).
 //! [`CreaseGraph::constraints`] gives the constraint set ψ of the final graph.
+//!
+//! # Readings where the thesis is silent or ambiguous
+//!
+//! - **r2's roles.** c1 is the vertex whose last incoming crease has the shared facet on
+//!   its right; c2 is deleted unless only c2 is in G0. For a G0 vertex that already owns
+//!   slots, the compared facets must be the open ones (c1 without s1, c2 without s3), and
+//!   a vertex is never combined with its own ancestor (that would close a cycle; with
+//!   vertices r1 created it cannot happen, only G0 vertices with successors could).
+//! - **Eq. 35.** The deleted vertex's own length and sector leave Φ, except a sector a
+//!   surviving placement still uses (s2 is placed by α_s1 + α_s2, so α_s1 outlives a
+//!   deleted s1): substituting it by a measured angle would make s2's position depend on
+//!   itself whenever the combined vertex descends from s2 (e.g. `2, 4, (3, 6)`). The
+//!   sectors and lengths next to moved creases are measured from the coordinates instead.
+//! - **Table 1, r1,3** writes `R(α_s3) d(a,p1)` for s3; Eq. 28 and r1,6 use `R(−α_s3)`,
+//!   which is what keeps s3 clockwise of p1. We use the minus sign.
+//! - **Isomorphism** fixes G0's vertices (they carry coordinates and drives); for the
+//!   thesis's G0 every direction-preserving isomorphism does so anyway.
+//! - **Filters' order.** Isomorphic (to any earlier graph) first; then mirror (its mirror
+//!   image equals an earlier graph that was kept); then validity. A graph without an
+//!   extended vertex has no gripping vertex and is invalid.
+//!
+//! # Counts (gripper and robotic arm, G0 of Fig. 40)
+//!
+//! Without filters N_max = 3 gives exactly the thesis's 291 graphs (G0, the root, not
+//! counted). With all filters we find 53 meaningful graphs and 1194 design alternatives
+//! against the thesis's 52 and 1170: 1194 − 1170 = 24 = 2³ × 3, so the thesis lists one
+//! graph with N = 3 fewer. Reading the isomorphism without the mark gives 51 and loses
+//! `2, 4, 3, (6, 11)`, which the thesis names as meaningful; reflection-insensitive
+//! isomorphism, a mirror check that ignores the mark, comparing mirror images only with
+//! meaningful graphs, or checking mirror before isomorphism all give 53 again.
 
 mod canon;
 mod enumerate;
@@ -45,7 +75,7 @@ mod notation;
 mod rules;
 
 pub use canon::Code;
-pub use enumerate::{Enumeration, Filters, LevelCounts, Node, Status};
+pub use enumerate::{Enumeration, Filters, LevelCounts, Node, Status, TooLarge};
 pub use graph::{CreaseGraph, FacetBoundary, FacetError};
 pub use notation::{NotationError, Step, format_sequence, parse_sequence};
 pub use rules::{R2Match, RuleError};

@@ -57,7 +57,11 @@ pub enum NotationError {
 
 /// Write a sequence: steps joined by `", "`.
 pub fn format_sequence(steps: &[Step]) -> String {
-    steps.iter().map(Step::to_string).collect::<Vec<_>>().join(", ")
+    steps
+        .iter()
+        .map(Step::to_string)
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Read a sequence such as `2, 3, (4, 8), 4, (7, 8)` (spaces optional; the empty string is

@@ -6,7 +6,7 @@ use petgraph::algo::has_path_connecting;
 use super::graph::CreaseGraph;
 use super::notation::Step;
 use super::{
-    Cid, ConstraintSpec, Created, Crease, CreaseOrigin, FacetId, Placement, R1Record, R2Record,
+    Cid, ConstraintSpec, Crease, CreaseOrigin, Created, FacetId, Placement, R1Record, R2Record,
     StepRecord, Substitution, VarId, VarKind, Variable, VertexType, Vid,
 };
 
@@ -41,7 +41,8 @@ enum NoR2 {
 
 impl CreaseGraph {
     fn vname(&self, v: Vid) -> String {
-        self.name(v).map_or_else(|| format!("(deleted {})", v.0), |n| format!("v{n}"))
+        self.name(v)
+            .map_or_else(|| format!("(deleted {})", v.0), |n| format!("v{n}"))
     }
 
     /// Whether r1 matches `a` (type χ). N_max is the enumeration's business.
@@ -115,7 +116,13 @@ impl CreaseGraph {
             let vname = self.order.len() + 1;
             let cid = Cid(self.edge_of.len() as u32);
             let sector = self.new_var(VarKind::Sector, format!("α_{vname}"), step, cid, vid);
-            let length = self.new_var(VarKind::Length, format!("l_{aname},{vname}"), step, cid, vid);
+            let length = self.new_var(
+                VarKind::Length,
+                format!("l_{aname},{vname}"),
+                step,
+                cid,
+                vid,
+            );
             variables.extend([sector, length]);
             sector_of[k] = Some(sector);
             let placement = match k {
@@ -202,22 +209,44 @@ impl CreaseGraph {
         let s = slots.map(|c| c.expect("all slots filled"));
         let mut constraints = Vec::new();
         if let Some(var) = sector_of[0] {
-            constraints.push(ConstraintSpec::Sector { vertex: a, from: pm, to: s[0], var: Some(var) });
+            constraints.push(ConstraintSpec::Sector {
+                vertex: a,
+                from: pm,
+                to: s[0],
+                var: Some(var),
+            });
         }
         if let Some(var) = sector_of[1] {
-            constraints.push(ConstraintSpec::Sector { vertex: a, from: s[0], to: s[1], var: Some(var) });
+            constraints.push(ConstraintSpec::Sector {
+                vertex: a,
+                from: s[0],
+                to: s[1],
+                var: Some(var),
+            });
         }
         if let Some(var) = sector_of[2] {
-            constraints.push(ConstraintSpec::Sector { vertex: a, from: s[2], to: p1, var: Some(var) });
+            constraints.push(ConstraintSpec::Sector {
+                vertex: a,
+                from: s[2],
+                to: p1,
+                var: Some(var),
+            });
         }
         let (rf, rt) = if sector_of[0].is_some() && v.slots[1].is_some() {
             (s[0], s[1])
         } else {
             (s[1], s[2])
         };
-        constraints.push(ConstraintSpec::Remainder { vertex: a, from: rf, to: rt });
+        constraints.push(ConstraintSpec::Remainder {
+            vertex: a,
+            from: rf,
+            to: rt,
+        });
         for c in &created {
-            constraints.push(ConstraintSpec::Length { crease: c.crease, var: Some(c.placement.length) });
+            constraints.push(ConstraintSpec::Length {
+                crease: c.crease,
+                var: Some(c.placement.length),
+            });
         }
         constraints.push(ConstraintSpec::RigidFoldability { vertex: a });
 
@@ -237,13 +266,27 @@ impl CreaseGraph {
         Ok(())
     }
 
-    fn new_var(&mut self, kind: VarKind, base: String, step: usize, crease: Cid, vertex: Vid) -> VarId {
+    fn new_var(
+        &mut self,
+        kind: VarKind,
+        base: String,
+        step: usize,
+        crease: Cid,
+        vertex: Vid,
+    ) -> VarId {
         let mut name = base;
         while self.variables.iter().any(|v| v.name == name) {
             name.push('\'');
         }
         let id = VarId(self.variables.len() as u32);
-        self.variables.push(Variable { id, kind, name, step, crease, vertex });
+        self.variables.push(Variable {
+            id,
+            kind,
+            name,
+            step,
+            crease,
+            vertex,
+        });
         id
     }
 
@@ -292,7 +335,10 @@ impl CreaseGraph {
         // Only G0 vertices can be χ and have successors; combining one with a descendant
         // would close a cycle.
         if a.slots.iter().any(Option::is_some) || b.slots.iter().any(Option::is_some) {
-            let (na, nb) = (self.node_of[c1.ix()].expect("living"), self.node_of[c2.ix()].expect("living"));
+            let (na, nb) = (
+                self.node_of[c1.ix()].expect("living"),
+                self.node_of[c2.ix()].expect("living"),
+            );
             if has_path_connecting(&self.g, na, nb, None) {
                 return Err(NoR2::Ancestor(c1, c2));
             }
@@ -310,7 +356,13 @@ impl CreaseGraph {
                 return Err(RuleError(format!("vertex {} does not exist", v.0)));
             }
         }
-        let head = || format!("r2 does not match {} and {}", self.vname(c1), self.vname(c2));
+        let head = || {
+            format!(
+                "r2 does not match {} and {}",
+                self.vname(c1),
+                self.vname(c2)
+            )
+        };
         self.r2_reason(c1, c2).map_err(|why| {
             RuleError(match why {
                 NoR2::Same => format!("{}: a vertex cannot be combined with itself", head()),
@@ -338,7 +390,10 @@ impl CreaseGraph {
     /// Records Eq. 34 and the variables eliminated with their substitutes (Eq. 35).
     pub fn combine(&mut self, m: R2Match) -> Result<(), RuleError> {
         self.check_combine(m.c1, m.c2)?;
-        let (n1, n2) = (self.name(m.c1).expect("living"), self.name(m.c2).expect("living"));
+        let (n1, n2) = (
+            self.name(m.c1).expect("living"),
+            self.name(m.c2).expect("living"),
+        );
         // Pairs are written sorted; only when both roles match is the second one written
         // with the larger name first, so that the notation stays unambiguous.
         let names = if n1 > n2 && self.r2_reason(m.c2, m.c1).is_ok() {
@@ -348,7 +403,11 @@ impl CreaseGraph {
         };
         let a = self.vx(m.c1).clone();
         let b = self.vx(m.c2).clone();
-        let (survivor, deleted) = if b.in_g0() && !a.in_g0() { (m.c2, m.c1) } else { (m.c1, m.c2) };
+        let (survivor, deleted) = if b.in_g0() && !a.in_g0() {
+            (m.c2, m.c1)
+        } else {
+            (m.c1, m.c2)
+        };
         let dv = if deleted == m.c2 { &b } else { &a };
         if dv.slots.iter().any(Option::is_some) {
             return Err(RuleError(format!(
@@ -398,7 +457,11 @@ impl CreaseGraph {
             removed_placement,
             eliminated,
             substitutions,
-            constraint: ConstraintSpec::MergedSector { vertex: survivor, from, to },
+            constraint: ConstraintSpec::MergedSector {
+                vertex: survivor,
+                from,
+                to,
+            },
         }));
         Ok(())
     }
@@ -408,7 +471,10 @@ impl CreaseGraph {
     fn substitute(&self, var: VarId) -> Substitution {
         let v = &self.variables[var.0 as usize];
         if v.kind == VarKind::Length {
-            return Substitution::Length { var, crease: v.crease };
+            return Substitution::Length {
+                var,
+                crease: v.crease,
+            };
         }
         let placement = match &self.steps[v.step] {
             StepRecord::R1(r) => r
@@ -425,7 +491,12 @@ impl CreaseGraph {
             reference: placement.reference,
             crease: v.crease,
             sign: placement.sign,
-            minus: placement.sectors.iter().copied().filter(|&s| s != var).collect(),
+            minus: placement
+                .sectors
+                .iter()
+                .copied()
+                .filter(|&s| s != var)
+                .collect(),
         }
     }
 
@@ -456,7 +527,11 @@ impl CreaseGraph {
                     out.push((Step::Combine(ni, nj), R2Match { c1: vi, c2: vj }));
                 }
                 if self.r2_reason(vj, vi).is_ok() {
-                    let step = if first { Step::Combine(nj, ni) } else { Step::Combine(ni, nj) };
+                    let step = if first {
+                        Step::Combine(nj, ni)
+                    } else {
+                        Step::Combine(ni, nj)
+                    };
                     out.push((step, R2Match { c1: vj, c2: vi }));
                 }
             }
@@ -495,6 +570,9 @@ impl CreaseGraph {
     }
 
     fn no_vertex(&self, n: usize) -> RuleError {
-        RuleError(format!("there is no vertex v{n} (the graph has v1 … v{})", self.order.len()))
+        RuleError(format!(
+            "there is no vertex v{n} (the graph has v1 … v{})",
+            self.order.len()
+        ))
     }
 }

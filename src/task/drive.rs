@@ -16,7 +16,10 @@ impl Drive {
     /// Parse `text`. Errors say what is allowed.
     pub fn parse(text: &str) -> Result<Drive, String> {
         let expr = DriveExpr::parse(text).map_err(|e| {
-            format!("\"{text}\" is not a driving-angle expression: {}", e.message)
+            format!(
+                "\"{text}\" is not a driving-angle expression: {}",
+                e.message
+            )
         })?;
         if !uses_t(&expr) {
             return Err(format!(
@@ -50,9 +53,10 @@ fn uses_t(e: &DriveExpr) -> bool {
         DriveExpr::Num(_) => false,
         DriveExpr::T => true,
         DriveExpr::Neg(a) => uses_t(a),
-        DriveExpr::Add(a, b) | DriveExpr::Sub(a, b) | DriveExpr::Mul(a, b) | DriveExpr::Div(a, b) => {
-            uses_t(a) || uses_t(b)
-        }
+        DriveExpr::Add(a, b)
+        | DriveExpr::Sub(a, b)
+        | DriveExpr::Mul(a, b)
+        | DriveExpr::Div(a, b) => uses_t(a) || uses_t(b),
     }
 }
 

@@ -72,15 +72,25 @@ pub struct MirrorMap {
 /// Angles closer than this are one direction (two creases on top of each other).
 const ANGLE_EPS: f64 = 1e-9;
 
-pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial, mirror_xz: bool) -> Result<InitialGraph, TaskError> {
+pub(crate) fn build(
+    cx: &Ctx<'_>,
+    raw: &RawInitial,
+    mirror_xz: bool,
+) -> Result<InitialGraph, TaskError> {
     let vf = |i: usize| format!("initial_graph.vertices[{i}]");
     let cf = |i: usize| format!("initial_graph.creases[{i}]");
 
     if raw.vertices.is_empty() {
-        return Err(cx.err("initial_graph.vertices", "no vertices: G0 needs at least one crease and its two vertices"));
+        return Err(cx.err(
+            "initial_graph.vertices",
+            "no vertices: G0 needs at least one crease and its two vertices",
+        ));
     }
     if raw.creases.is_empty() {
-        return Err(cx.err("initial_graph.creases", "no creases: G0 needs at least one crease"));
+        return Err(cx.err(
+            "initial_graph.creases",
+            "no creases: G0 needs at least one crease",
+        ));
     }
 
     // Vertices: unique ids, finite and distinct coordinates.
@@ -88,12 +98,19 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial, mirror_xz: bool) -> Result<I
     let mut vertices = Vec::with_capacity(raw.vertices.len());
     for (i, v) in raw.vertices.iter().enumerate() {
         if v.id.trim().is_empty() {
-            return Err(cx.err(format!("{}.id", vf(i)), "empty id: give every vertex a name"));
+            return Err(cx.err(
+                format!("{}.id", vf(i)),
+                "empty id: give every vertex a name",
+            ));
         }
         if let Some(j) = index.insert(v.id.as_str(), i) {
             return Err(cx.err(
                 format!("{}.id", vf(i)),
-                format!("duplicate id \"{}\" (also {}): vertex ids must be unique", v.id, vf(j)),
+                format!(
+                    "duplicate id \"{}\" (also {}): vertex ids must be unique",
+                    v.id,
+                    vf(j)
+                ),
             ));
         }
         let xy = [
@@ -120,7 +137,10 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial, mirror_xz: bool) -> Result<I
             if (a[0] - b[0]).hypot(a[1] - b[1]) <= tol {
                 return Err(cx.err(
                     format!("{}.xy", vf(i)),
-                    format!("vertex \"{}\" lies on vertex \"{}\": vertices need distinct positions", vertices[i].id, vertices[j].id),
+                    format!(
+                        "vertex \"{}\" lies on vertex \"{}\": vertices need distinct positions",
+                        vertices[i].id, vertices[j].id
+                    ),
                 ));
             }
         }
@@ -147,14 +167,27 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial, mirror_xz: bool) -> Result<I
             index.get(id).copied().ok_or_else(|| {
                 cx.err(
                     format!("{}.{field}", cf(i)),
-                    format!("unknown vertex \"{id}\" (defined: {})", raw.vertices.iter().map(|v| v.id.as_str()).collect::<Vec<_>>().join(", ")),
+                    format!(
+                        "unknown vertex \"{id}\" (defined: {})",
+                        raw.vertices
+                            .iter()
+                            .map(|v| v.id.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
                 )
             })
         };
         let tail = lookup(&c.from, "from")?;
         let head = lookup(&c.to, "to")?;
         if tail == head {
-            return Err(cx.err(format!("{}.to", cf(i)), format!("crease from \"{}\" to itself: a crease joins two different vertices", c.from)));
+            return Err(cx.err(
+                format!("{}.to", cf(i)),
+                format!(
+                    "crease from \"{}\" to itself: a crease joins two different vertices",
+                    c.from
+                ),
+            ));
         }
         let key = (tail.min(head), tail.max(head));
         if let Some(j) = pairs.insert(key, i) {
@@ -163,7 +196,10 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial, mirror_xz: bool) -> Result<I
         if c.left == c.right {
             return Err(cx.err(
                 format!("{}.right", cf(i)),
-                format!("left and right facet are both \"{}\": a crease separates two different facets", c.left),
+                format!(
+                    "left and right facet are both \"{}\": a crease separates two different facets",
+                    c.left
+                ),
             ));
         }
         let left = facet_ix(&c.left, format!("{}.left", cf(i)))?;
@@ -172,15 +208,34 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial, mirror_xz: bool) -> Result<I
             None => None,
             Some(d) => Some(Drive::parse(d).map_err(|m| cx.err(format!("{}.drive", cf(i)), m))?),
         };
+        creases.push(InitialCrease {
+            tail,
+            head,
+            left,
+            right,
+            drive,
+        });
+    }
+
+    // An extendable vertex needs incoming creases: r1 places new creases from p1 and pm.
+    for (i, v) in vertices.iter().enumerate() {
+        if v.ty == VertexType::Extendable && !creases.iter().any(|c| c.head == i) {
+            return Err(cx.err(
+                format!("{}.type", vf(i)),
+                format!("vertex \"{}\" has no incoming crease (a source) and cannot be extendable: make it \"terminal\"", v.id),
+            ));
+        }
+    }
+    for (i, (c, raw)) in creases.iter().zip(&raw.creases).enumerate() {
         // A crease leaving a terminal vertex is driven: its angle is prescribed. A crease
         // leaving an extendable vertex gets its angle from the PTU when the tail is extended.
-        match (vertices[tail].ty, &drive) {
+        match (vertices[c.tail].ty, &c.drive) {
             (VertexType::Terminal, None) => {
                 return Err(cx.err(
                     format!("{}.drive", cf(i)),
                     format!(
                         "crease {} → {} leaves terminal vertex \"{}\", so it is driven and needs a driving angle, e.g. drive = \"t\"",
-                        c.from, c.to, c.from
+                        raw.from, raw.to, raw.from
                     ),
                 ));
             }
@@ -189,13 +244,12 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial, mirror_xz: bool) -> Result<I
                     format!("{}.drive", cf(i)),
                     format!(
                         "crease {} → {} leaves extendable vertex \"{}\"; its angle follows from the PTU once \"{}\" is extended, so it takes no drive",
-                        c.from, c.to, c.from, c.from
+                        raw.from, raw.to, raw.from, raw.from
                     ),
                 ));
             }
             _ => {}
         }
-        creases.push(InitialCrease { tail, head, left, right, drive });
     }
 
     // Topology: acyclic, connected, fewer than three successors.
@@ -247,15 +301,26 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial, mirror_xz: bool) -> Result<I
         order_vertex(cx, &mut vertices, &creases, &facets, vi, ring)?;
     }
 
-    let mirror = if mirror_xz { Some(mirror_map(cx, &vertices, &creases, &facets, tol)?) } else { None };
-
-    let g = InitialGraph { vertices, creases, facets, mirror };
+    let mut g = InitialGraph {
+        vertices,
+        creases,
+        facets,
+        mirror: None,
+    };
 
     // Facets: every facet's boundary must be one chain (closed, or open at the paper's edge).
     let graph = CreaseGraph::from_initial(Arc::new(g.clone()));
     if let Err(e) = graph.facet_boundaries() {
-        return Err(cx.err("initial_graph.creases", format!("inconsistent facet labels: {e}")));
+        return Err(cx.err(
+            "initial_graph.creases",
+            format!("inconsistent facet labels: {e}"),
+        ));
     }
+    if !mirror_xz {
+        return Ok(g);
+    }
+    g.mirror = Some(mirror_map(cx, &g.vertices, &g.creases, &g.facets, tol)?);
+    let graph = CreaseGraph::from_initial(Arc::new(g.clone()));
     if g.mirror.is_some() && graph.mirror_code().as_ref() != Some(&graph.canonical_code()) {
         return Err(cx.err(
             "symmetry.mirror_xz",
@@ -267,11 +332,20 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial, mirror_xz: bool) -> Result<I
 
 /// The facet on the counter-clockwise / clockwise side of crease `c` seen from vertex `v`.
 fn sides(c: &InitialCrease, v: usize) -> (usize, usize) {
-    if c.tail == v { (c.left, c.right) } else { (c.right, c.left) }
+    if c.tail == v {
+        (c.left, c.right)
+    } else {
+        (c.right, c.left)
+    }
 }
 
 /// Incident creases sorted counter-clockwise by direction.
-fn ring_at(cx: &Ctx<'_>, vs: &[InitialVertex], cs: &[InitialCrease], v: usize) -> Result<Vec<usize>, TaskError> {
+fn ring_at(
+    cx: &Ctx<'_>,
+    vs: &[InitialVertex],
+    cs: &[InitialCrease],
+    v: usize,
+) -> Result<Vec<usize>, TaskError> {
     let p = vs[v].xy;
     let mut rays: Vec<(f64, usize)> = cs
         .iter()
@@ -383,17 +457,29 @@ fn order_vertex(
         slots[2 - k] = Some(c);
     }
     let vx = &mut vs[v];
-    vx.ring = preds.iter().chain(slots.iter().flatten()).copied().collect();
+    vx.ring = preds
+        .iter()
+        .chain(slots.iter().flatten())
+        .copied()
+        .collect();
     vx.preds = preds;
     vx.slots = slots;
     Ok(())
 }
 
-fn mirror_map(cx: &Ctx<'_>, vs: &[InitialVertex], cs: &[InitialCrease], facets: &[String], tol: f64) -> Result<MirrorMap, TaskError> {
+fn mirror_map(
+    cx: &Ctx<'_>,
+    vs: &[InitialVertex],
+    cs: &[InitialCrease],
+    facets: &[String],
+    tol: f64,
+) -> Result<MirrorMap, TaskError> {
     let field = "symmetry.mirror_xz";
     let mut vertex = Vec::with_capacity(vs.len());
     for v in vs {
-        let m = vs.iter().position(|u| (u.xy[0] - v.xy[0]).abs() <= tol && (u.xy[1] + v.xy[1]).abs() <= tol);
+        let m = vs
+            .iter()
+            .position(|u| (u.xy[0] - v.xy[0]).abs() <= tol && (u.xy[1] + v.xy[1]).abs() <= tol);
         let Some(m) = m else {
             return Err(cx.err(
                 field,
@@ -401,16 +487,28 @@ fn mirror_map(cx: &Ctx<'_>, vs: &[InitialVertex], cs: &[InitialCrease], facets: 
             ));
         };
         if vs[m].ty != v.ty {
-            return Err(cx.err(field, format!("G0 is not symmetric: \"{}\" and its mirror image \"{}\" have different types", v.id, vs[m].id)));
+            return Err(cx.err(
+                field,
+                format!(
+                    "G0 is not symmetric: \"{}\" and its mirror image \"{}\" have different types",
+                    v.id, vs[m].id
+                ),
+            ));
         }
         vertex.push(m);
     }
     let mut facet = vec![usize::MAX; facets.len()];
     for c in cs {
-        let Some(m) = cs.iter().find(|d| d.tail == vertex[c.tail] && d.head == vertex[c.head]) else {
+        let Some(m) = cs
+            .iter()
+            .find(|d| d.tail == vertex[c.tail] && d.head == vertex[c.head])
+        else {
             return Err(cx.err(
                 field,
-                format!("G0 is not symmetric: crease {} → {} has no mirror image", vs[c.tail].id, vs[c.head].id),
+                format!(
+                    "G0 is not symmetric: crease {} → {} has no mirror image",
+                    vs[c.tail].id, vs[c.head].id
+                ),
             ));
         };
         if c.drive != m.drive {

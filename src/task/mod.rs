@@ -149,8 +149,9 @@ pub struct Cylinder {
     pub to: [f64; 3],
 }
 
-/// Largest N_max accepted: each extension multiplies the number of graphs by roughly ten.
-pub const N_MAX_LIMIT: usize = 8;
+/// Largest N_max accepted: each extension multiplies the number of graphs by roughly
+/// twenty (with all filters: 101 graphs at N_max = 3, 1,929 at 4, 41,549 at 5).
+pub const N_MAX_LIMIT: usize = 6;
 
 // ---------------------------------------------------------------------------------------
 // Raw file format (serde), checked by `Task::from_toml_str`.
@@ -337,7 +338,7 @@ impl Task {
             return Err(cx.err(
                 "grammar.n_max",
                 format!(
-                    "{n_max} is out of range: allowed 0..={N_MAX_LIMIT} (the number of graphs grows about tenfold per internal vertex)"
+                    "{n_max} is out of range: allowed 0..={N_MAX_LIMIT} (the number of graphs grows about twentyfold per internal vertex)"
                 ),
             ));
         }
@@ -353,7 +354,9 @@ impl Task {
                 if t_max == 0.0 || t_max.abs() > std::f64::consts::PI + 1e-12 {
                     return Err(cx.err(
                         "motion.t_max",
-                        format!("{t_max} is not allowed: t_max must be nonzero and within [-pi, pi]"),
+                        format!(
+                            "{t_max} is not allowed: t_max must be nonzero and within [-pi, pi]"
+                        ),
                     ));
                 }
                 Some(Motion { t_max })
@@ -368,13 +371,22 @@ impl Task {
                 let alpha_min = cx.num("bounds.alpha_min", &b.alpha_min)?;
                 let alpha_max = cx.num("bounds.alpha_max", &b.alpha_max)?;
                 if l_min <= 0.0 {
-                    return Err(cx.err("bounds.l_min", format!("{l_min} is not allowed: lengths must be > 0")));
+                    return Err(cx.err(
+                        "bounds.l_min",
+                        format!("{l_min} is not allowed: lengths must be > 0"),
+                    ));
                 }
                 if l_max <= l_min {
-                    return Err(cx.err("bounds.l_max", format!("{l_max} is not allowed: l_max must exceed l_min = {l_min}")));
+                    return Err(cx.err(
+                        "bounds.l_max",
+                        format!("{l_max} is not allowed: l_max must exceed l_min = {l_min}"),
+                    ));
                 }
                 if !(alpha_min > 0.0 && alpha_min < std::f64::consts::PI) {
-                    return Err(cx.err("bounds.alpha_min", format!("{alpha_min} is not allowed: sector angles lie in (0, pi)")));
+                    return Err(cx.err(
+                        "bounds.alpha_min",
+                        format!("{alpha_min} is not allowed: sector angles lie in (0, pi)"),
+                    ));
                 }
                 if !(alpha_max > alpha_min && alpha_max < std::f64::consts::PI) {
                     return Err(cx.err(
@@ -382,7 +394,12 @@ impl Task {
                         format!("{alpha_max} is not allowed: alpha_max must lie in (alpha_min = {alpha_min}, pi)"),
                     ));
                 }
-                Some(Bounds { l_min, l_max, alpha_min, alpha_max })
+                Some(Bounds {
+                    l_min,
+                    l_max,
+                    alpha_min,
+                    alpha_max,
+                })
             }
         };
 
@@ -390,22 +407,38 @@ impl Task {
             None => None,
             Some(o) => {
                 let Some(motion) = motion else {
-                    return Err(cx.err("objective", "an objective needs the motion range: add [motion] with t_max"));
+                    return Err(cx.err(
+                        "objective",
+                        "an objective needs the motion range: add [motion] with t_max",
+                    ));
                 };
                 let threshold = cx.num("objective.threshold", &o.threshold)?;
                 if threshold < 0.0 {
-                    return Err(cx.err("objective.threshold", format!("{threshold} is not allowed: the threshold must be ≥ 0")));
+                    return Err(cx.err(
+                        "objective.threshold",
+                        format!("{threshold} is not allowed: the threshold must be ≥ 0"),
+                    ));
                 }
                 if o.targets.is_empty() {
-                    return Err(cx.err("objective.targets", "no targets: give at least one [[objective.targets]] with t and point"));
+                    return Err(cx.err(
+                        "objective.targets",
+                        "no targets: give at least one [[objective.targets]] with t and point",
+                    ));
                 }
-                let (lo, hi) = if motion.t_max > 0.0 { (0.0, motion.t_max) } else { (motion.t_max, 0.0) };
+                let (lo, hi) = if motion.t_max > 0.0 {
+                    (0.0, motion.t_max)
+                } else {
+                    (motion.t_max, 0.0)
+                };
                 let mut targets = Vec::with_capacity(o.targets.len());
                 for (i, t) in o.targets.iter().enumerate() {
                     let f = format!("objective.targets[{i}]");
                     let tv = cx.num(&format!("{f}.t"), &t.t)?;
                     if tv < lo - 1e-12 || tv > hi + 1e-12 {
-                        return Err(cx.err(format!("{f}.t"), format!("{tv} is outside the motion range [{lo}, {hi}]")));
+                        return Err(cx.err(
+                            format!("{f}.t"),
+                            format!("{tv} is outside the motion range [{lo}, {hi}]"),
+                        ));
                     }
                     let point = cx.point(&format!("{f}.point"), &t.point)?;
                     let weight = match &t.weight {
@@ -413,9 +446,16 @@ impl Task {
                         Some(w) => cx.num(&format!("{f}.weight"), w)?,
                     };
                     if weight <= 0.0 {
-                        return Err(cx.err(format!("{f}.weight"), format!("{weight} is not allowed: weights must be > 0")));
+                        return Err(cx.err(
+                            format!("{f}.weight"),
+                            format!("{weight} is not allowed: weights must be > 0"),
+                        ));
                     }
-                    targets.push(Target { t: tv, point, weight });
+                    targets.push(Target {
+                        t: tv,
+                        point,
+                        weight,
+                    });
                 }
                 Some(Objective { targets, threshold })
             }
@@ -425,23 +465,38 @@ impl Task {
             None => None,
             Some(c) => {
                 if c.states < 2 {
-                    return Err(cx.err("check.states", format!("{} is not allowed: at least 2 states (0 and t_max)", c.states)));
+                    return Err(cx.err(
+                        "check.states",
+                        format!(
+                            "{} is not allowed: at least 2 states (0 and t_max)",
+                            c.states
+                        ),
+                    ));
                 }
                 let mut cylinders = Vec::new();
                 for (i, cy) in c.cylinders.iter().enumerate() {
                     let f = format!("check.cylinders[{i}]");
                     let radius = cx.num(&format!("{f}.radius"), &cy.radius)?;
                     if radius <= 0.0 {
-                        return Err(cx.err(format!("{f}.radius"), format!("{radius} is not allowed: the radius must be > 0")));
+                        return Err(cx.err(
+                            format!("{f}.radius"),
+                            format!("{radius} is not allowed: the radius must be > 0"),
+                        ));
                     }
                     let from = cx.point(&format!("{f}.from"), &cy.from)?;
                     let to = cx.point(&format!("{f}.to"), &cy.to)?;
                     if from == to {
-                        return Err(cx.err(format!("{f}.to"), "the axis end equals its start: the axis needs two distinct points"));
+                        return Err(cx.err(
+                            format!("{f}.to"),
+                            "the axis end equals its start: the axis needs two distinct points",
+                        ));
                     }
                     cylinders.push(Cylinder { radius, from, to });
                 }
-                Some(CheckSpec { states: c.states as usize, cylinders })
+                Some(CheckSpec {
+                    states: c.states as usize,
+                    cylinders,
+                })
             }
         };
 
