@@ -247,9 +247,7 @@ impl Builder {
                     let drive = match drive {
                         Some(d) => {
                             driven.push(i);
-                            Some(DriveExpr::parse(&d.to_string()).map_err(|e| {
-                                PlanError(format!("driving angle of crease {}: {e}", i + 1))
-                            })?)
+                            Some(d.expr().clone())
                         }
                         None => None,
                     };

@@ -303,8 +303,8 @@ pub fn minimize<P: Problem>(problem: &P, opts: &Options) -> Solution {
             problem.eval(&transform.x(&y), &mut eval);
             evaluations += 1;
             let violation = eval.violation();
-            for k in 0..m {
-                lambda[k] = (lambda[k] - mu * eval.g[k]).max(0.0);
+            for (l, g) in lambda.iter_mut().zip(&eval.g) {
+                *l = (*l - mu * g).max(0.0);
             }
             if violation <= opts.feasibility_tol {
                 if opts.target.is_some_and(|t| eval.f <= t) {
