@@ -7,3 +7,4 @@ pub mod jit;
 pub use diff::{gradient, gradients};
 pub use dual::Dual;
 pub use jit::{CompileError, CompiledFn};
+pub mod simplify;
