@@ -2,6 +2,8 @@
 
 use clap::{Parser, Subcommand};
 
+pub mod vertex;
+
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
 #[derive(Debug, Parser)]
 #[command(name = "foldsynth", version, about)]
@@ -13,9 +15,14 @@ pub struct Cli {
 
 /// The subcommands.
 #[derive(Debug, Subcommand)]
-pub enum Command {}
+pub enum Command {
+    /// The PTU for one vertex: unit, internal, start/end and dihedral angles over t.
+    Vertex(vertex::VertexArgs),
+}
 
 /// Run one parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
-    match cli.command {}
+    match cli.command {
+        Command::Vertex(a) => vertex::run(a),
+    }
 }

@@ -44,6 +44,12 @@ pub trait Scalar:
     /// The numeric value when it is known without evaluation (always for `f64`,
     /// for constant-folded symbolic nodes).
     fn to_f64(&self) -> Option<f64>;
+
+    /// `max(0, x)`, written as `(x + x·sgn(x)) / 2` so that every implementation gets it
+    /// from the primitives (derivative: 1 for x > 0, 0 for x < 0).
+    fn max0(&self) -> Self {
+        (self.clone() + self.clone() * self.sgn()) * 0.5
+    }
 }
 
 /// Sign with `sgn(0) = 0` (and NaN mapped to 0), shared by every implementation.
