@@ -2,6 +2,8 @@
 
 use clap::{Parser, Subcommand};
 
+pub mod bench;
+pub mod formulas;
 pub mod vertex;
 
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
@@ -18,11 +20,17 @@ pub struct Cli {
 pub enum Command {
     /// The PTU for one vertex: unit, internal, start/end and dihedral angles over t.
     Vertex(vertex::VertexArgs),
+    /// Benchmarks measured in one run (`foldsynth bench vertex …`).
+    Bench(bench::BenchArgs),
+    /// Symbolic formulas of U, θ, φ of a vertex (plain, LaTeX, Mathematica, Python, DOT).
+    Formulas(formulas::FormulasArgs),
 }
 
 /// Run one parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Vertex(a) => vertex::run(a),
+        Command::Bench(a) => bench::run(a),
+        Command::Formulas(a) => formulas::run(a),
     }
 }

@@ -6,11 +6,12 @@
 //! instruction; `sgn`, `clamp` and `select` are `fcmp` + `select`, with exactly the NaN
 //! behaviour of [`Node::eval_with`].
 
-use crate::expr::{ExprGraph, Node, NodeId, ShapeError, check_indices};
+use crate::expr::{ExprGraph, FxHashMap, Node, NodeId, ShapeError, check_indices};
 use crate::kinematics::acos_clamped;
 use cranelift_codegen::ir::condcodes::FloatCC;
 use cranelift_codegen::ir::{
-    AbiParam, FuncRef, InstBuilder, MemFlagsData, Signature, UserFuncName, Value, types,
+    AbiParam, FuncRef, InstBuilder, MemFlagsData, Signature, StackSlotData, StackSlotKind,
+    UserFuncName, Value, types,
 };
 use cranelift_codegen::settings::{self, Configurable};
 use cranelift_codegen::Context;
@@ -44,6 +45,22 @@ extern "C" fn fs_acos(x: f64) -> f64 {
 }
 extern "C" fn fs_atan2(y: f64, x: f64) -> f64 {
     y.atan2(x)
+}
+
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+unsafe extern "C" {
+    /// glibc's `sincos`: one range reduction for both; bit-identical to `sin` and `cos`
+    /// (glibc computes all three with the same kernels; a test checks it).
+    fn sincos(x: f64, s: *mut f64, c: *mut f64);
+}
+
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+extern "C" fn sincos(x: f64, s: *mut f64, c: *mut f64) {
+    // SAFETY: the generated code passes two distinct, writable stack slots.
+    unsafe {
+        *s = x.sin();
+        *c = x.cos();
+    }
 }
 
 type RawFn = unsafe extern "C" fn(*const f64, *const f64, *mut f64);
@@ -119,6 +136,7 @@ impl CompiledFn {
         jb.symbol("foldsynth_cos", fs_cos as *const u8);
         jb.symbol("foldsynth_acos", fs_acos as *const u8);
         jb.symbol("foldsynth_atan2", fs_atan2 as *const u8);
+        jb.symbol("foldsynth_sincos", sincos as *const u8);
         let mut module = JITModule::new(jb);
         let result = build(&mut module, graph, outputs, &mark);
         match result {
@@ -206,6 +224,7 @@ struct Imports {
     cos: Option<FuncRef>,
     acos: Option<FuncRef>,
     atan2: Option<FuncRef>,
+    sincos: Option<FuncRef>,
 }
 
 fn build(
@@ -233,12 +252,31 @@ fn build(
             .declare_function(name, Linkage::Import, sig)
             .map_err(cg)
     };
+    let mut sig_sc = sig1.clone();
+    sig_sc.returns.clear();
+    sig_sc.params.push(AbiParam::new(ptr));
+    sig_sc.params.push(AbiParam::new(ptr));
     let ids = [
         declare("foldsynth_sin", &sig1)?,
         declare("foldsynth_cos", &sig1)?,
         declare("foldsynth_acos", &sig1)?,
         declare("foldsynth_atan2", &sig2)?,
+        declare("foldsynth_sincos", &sig_sc)?,
     ];
+    // sin x and cos x of one x, both needed: one sincos call.
+    let fused: Vec<bool> = graph
+        .nodes()
+        .iter()
+        .enumerate()
+        .map(|(i, n)| {
+            mark[i]
+                && match *n {
+                    Node::Sin(a) => graph.lookup(&Node::Cos(a)).is_some_and(|c| mark[c.index()]),
+                    Node::Cos(a) => graph.lookup(&Node::Sin(a)).is_some_and(|c| mark[c.index()]),
+                    _ => false,
+                }
+        })
+        .collect();
 
     let mut ctx: Context = module.make_context();
     ctx.func.signature = sig;
@@ -259,7 +297,12 @@ fn build(
             cos: None,
             acos: None,
             atan2: None,
+            sincos: None,
         };
+        let slot = b.create_sized_stack_slot(StackSlotData::new(StackSlotKind::ExplicitSlot, 16, 3));
+        let mut slot_addr: Option<Value> = None;
+        // Results of fused sincos calls, by argument node.
+        let mut sincos_done: FxHashMap<NodeId, (Value, Value)> = FxHashMap::default();
         let mut import = |slot: &mut Option<FuncRef>, id: FuncId, b: &mut FunctionBuilder| {
             *slot.get_or_insert_with(|| module.declare_func_in_func(id, b.func))
         };
@@ -279,6 +322,24 @@ fn build(
                 Node::Div(a, c) => b.ins().fdiv(v(a), v(c)),
                 Node::Neg(a) => b.ins().fneg(v(a)),
                 Node::Sqrt(a) => b.ins().sqrt(v(a)),
+                Node::Sin(a) | Node::Cos(a) if fused[i] => {
+                    let (sv, cv) = match sincos_done.get(&a) {
+                        Some(&r) => r,
+                        None => {
+                            let f = import(&mut imports.sincos, ids[4], &mut b);
+                            let addr = *slot_addr.get_or_insert_with(|| b.ins().stack_addr(ptr, slot, 0));
+                            let s_ptr = addr;
+                            let c_ptr = b.ins().iadd_imm_s(addr, 8);
+                            let arg = v(a);
+                            b.ins().call(f, &[arg, s_ptr, c_ptr]);
+                            let sv = b.ins().load(types::F64, mem, addr, 0);
+                            let cv = b.ins().load(types::F64, mem, addr, 8);
+                            sincos_done.insert(a, (sv, cv));
+                            (sv, cv)
+                        }
+                    };
+                    if matches!(node, Node::Sin(_)) { sv } else { cv }
+                }
                 Node::Sin(a) | Node::Cos(a) | Node::Acos(a) => {
                     let (slot, id) = match node {
                         Node::Sin(_) => (&mut imports.sin, ids[0]),

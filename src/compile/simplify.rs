@@ -14,6 +14,9 @@
 //!   root of a negative number, and `1 - c` is exact near `c = 1` (no cancellation);
 //! - `x - x → 0`, `x * 0 → 0`, `sin²x + cos²x → 1` only where the range analysis proves
 //!   `x` finite; `x / x → 1` only where it also proves `x ≠ 0`;
+//! - `(x + x·sgn x)/2 → select(x, x, 0)` (that is `max(0, x)`, how the kinematics
+//!   writes it): exact for finite `x` (`2x/2 = x`, `x - x = 0`), so again only where `x`
+//!   is proven finite;
 //! - clamps are removed only at the rebuild, by the exact range check of
 //!   [`ExprGraph::add`] (e-class ranges merge forms that differ by rounding, so they are
 //!   not trusted for that);
@@ -226,9 +229,15 @@ impl Analysis<Math> for Facts {
         } else {
             None
         };
-        let range = match konst {
-            Some(k) => Range::constant(k.value()),
-            None => Range::of(&kind, &ranges),
+        let range = match (konst, enode) {
+            (Some(k), _) => Range::constant(k.value()),
+            (None, Math::Select([c, a, _])) if egraph.find(*c) == egraph.find(*a) => {
+                Range::select_positive(&ranges[0], &ranges[2])
+            }
+            (None, Math::Mul([a, b])) if egraph.find(*a) == egraph.find(*b) => {
+                Range::square(&ranges[0])
+            }
+            (None, _) => Range::of(&kind, &ranges),
         };
         Data { konst, range }
     }
@@ -303,6 +312,9 @@ pub fn rules() -> Vec<Rewrite<Math, Facts>> {
         rw!("sin-neg"; "(sin (neg ?x))" => "(neg (sin ?x))"),
         rw!("cos-neg"; "(cos (neg ?x))" => "(cos ?x)"),
         rw!("pythagoras"; "(+ (* (sin ?x) (sin ?x)) (* (cos ?x) (cos ?x)))" => "1.0"
+            if is_finite("?x")),
+        // max(0, x) written with sgn (kinematics' `Scalar::max0`): one compare-select.
+        rw!("max0"; "(* 0.5 (+ ?x (* ?x (sgn ?x))))" => "(select ?x ?x 0.0)"
             if is_finite("?x")),
         rw!("sgn-sgn"; "(sgn (sgn ?x))" => "(sgn ?x)"),
         rw!("sgn-neg"; "(sgn (neg ?x))" => "(neg (sgn ?x))"),
@@ -690,5 +702,23 @@ mod tests {
             t2.eval(&[a, b], &[], &mut r2).unwrap();
             assert!((r1[0] - r2[0]).abs() <= 1e-12 * r1[0].abs().max(1.0), "{r1:?} {r2:?}");
         }
+    }
+}
+
+#[cfg(test)]
+mod max0_tests {
+    use super::*;
+    use crate::expr::Ctx;
+    use crate::kinematics::Scalar;
+
+    #[test]
+    fn max0_becomes_select() {
+        let ctx = Ctx::new();
+        let x = ctx.var(0).sin() * ctx.var(1);
+        let y = x.max0();
+        let id = ctx.node_id(&y);
+        let g = ctx.to_graph();
+        let (s, outs, _) = simplify(&g, &[id], &Limits::default());
+        assert!(matches!(s.node(outs[0]), Node::Select(..)), "{:?}", s.nodes());
     }
 }

@@ -346,6 +346,11 @@ impl ExprGraph {
         }
     }
 
+    /// The id of a node equal to `node`, if the graph has one (no folding).
+    pub fn lookup(&self, node: &Node) -> Option<NodeId> {
+        self.index.get(node).copied()
+    }
+
     /// Insert a node as it is (no folding), reusing an equal node.
     pub(crate) fn intern(&mut self, node: Node) -> NodeId {
         if let Some(&id) = self.index.get(&node) {
@@ -356,7 +361,11 @@ impl ExprGraph {
             .into_iter()
             .map(|c| self.ranges[c.index()])
             .collect();
-        let range = Range::of(&node, &args);
+        let range = match node {
+            Node::Select(c, a, _) if c == a => Range::select_positive(&args[0], &args[2]),
+            Node::Mul(a, b) if a == b => Range::square(&args[0]),
+            _ => Range::of(&node, &args),
+        };
         match node {
             Node::Var(i) => self.n_vars = self.n_vars.max(i as usize + 1),
             Node::Param(i) => self.n_params = self.n_params.max(i as usize + 1),

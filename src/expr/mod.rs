@@ -31,6 +31,7 @@ mod sym;
 
 pub use eval::{ShapeError, Tape};
 pub(crate) use eval::check_indices;
+pub(crate) use graph::FxHashMap;
 pub use graph::{Counts, ExprGraph};
 pub use node::{Children, Node, NodeId, Range, clamp_unit, select};
 pub use print::{Format, Names};

@@ -234,9 +234,9 @@ pub fn select(c: f64, a: f64, b: f64) -> f64 {
     if c > 0.0 { a } else { b }
 }
 
-/// What is known about a node's f64 value for every input with finite variables and
-/// parameters: if `finite`, the value is finite and lies in `[lo, hi]`; otherwise nothing
-/// is known (it may be NaN or infinite).
+/// What is known about a node's f64 value for every input whose variables and parameters
+/// are finite with magnitude at most [`INPUT_BOUND`]: if `finite`, the value is finite and
+/// lies in `[lo, hi]`; otherwise nothing is known (it may be NaN or infinite).
 ///
 /// The bounds are sound for the *computed* (rounded) values: round-to-nearest is monotone,
 /// so evaluating interval endpoints with the same f64 operations bounds every result.
@@ -249,6 +249,12 @@ pub struct Range {
     /// Whether the value is finite whenever all inputs are finite.
     pub finite: bool,
 }
+
+/// The magnitude assumed of every variable and parameter (angles, lengths, ±1 modes and
+/// task data are many orders below it). Without a bound, `α6 + α7` could overflow and
+/// nothing derived from two inputs would be known finite; with it, the analysis can prove
+/// e.g. `sin(α6 + α7 - U)` finite and fold `0 · that` to 0.
+pub const INPUT_BOUND: f64 = 1e150;
 
 /// The largest magnitude that, added to any finite f64, cannot overflow.
 const SAFE_ADD: f64 = 1e290;
@@ -357,7 +363,7 @@ impl Range {
         let unit = Range::interval(-1.0, 1.0);
         match *node {
             Const(c) => Range::constant(c),
-            Var(_) | Param(_) => Range::FINITE,
+            Var(_) | Param(_) => Range::interval(-INPUT_BOUND, INPUT_BOUND),
             Add(..) | Sub(..) => {
                 let (a, b) = (args[0], args[1]);
                 let b = if matches!(node, Sub(..)) {
@@ -471,6 +477,30 @@ impl Range {
             }
             Select(..) => Range::hull(&args[1], &args[2]),
         }
+    }
+
+    /// The range of `x * x` (never negative, unlike a general product of two `x` ranges).
+    pub fn square(x: &Range) -> Range {
+        if !x.bounded() {
+            return Range::of(&Node::Mul(NodeId(0), NodeId(0)), &[*x, *x]);
+        }
+        let (a, b) = (x.lo * x.lo, x.hi * x.hi);
+        let lo = if x.lo <= 0.0 && x.hi >= 0.0 { 0.0 } else { a.min(b) };
+        Range::interval(lo, a.max(b)).with_finite_check(lo, a.max(b))
+    }
+
+    /// The range of `select(x, x, b)` (`x` where `x > 0`, else `b`): like the hull, but
+    /// only the positive part of `x` survives (so `select(x, x, 0) ≥ 0`).
+    pub fn select_positive(x: &Range, b: &Range) -> Range {
+        if !(x.finite && b.finite) {
+            return Range::UNKNOWN;
+        }
+        let pos = Range {
+            lo: x.lo.max(0.0),
+            hi: x.hi.max(0.0),
+            finite: true,
+        };
+        Range::hull(&pos, b)
     }
 
     fn with_finite_check(self, lo: f64, hi: f64) -> Range {
