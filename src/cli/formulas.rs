@@ -3,7 +3,7 @@
 
 use crate::compile::simplify::{self, Limits};
 use crate::compile::{gradients, vertex::VertexModel};
-use crate::expr::{Counts, ExprGraph, Format, NodeId, print::print};
+use crate::expr::{Counts, ExprGraph, Format, Names, NodeId, print::print};
 use crate::kinematics::VertexSpec;
 use anyhow::{Context, Result};
 
@@ -54,8 +54,36 @@ pub struct FormulasArgs {
     pub symbolic_sectors: bool,
 }
 
-/// The formulas (and counts) as text in the requested format.
-pub fn render(args: &FormulasArgs) -> Result<String> {
+/// What `foldsynth formulas` prints: the graph, its named outputs and the counts.
+#[derive(Debug)]
+pub struct Formulas {
+    /// The vertex.
+    pub spec: VertexSpec,
+    /// The graph holding the printed outputs.
+    pub graph: ExprGraph,
+    /// The printed outputs: U1…3, theta1…3, phi1…3, then (with `--gradient`)
+    /// `dphi{k}_d{var}` for k = 1…3 and every variable.
+    pub outputs: Vec<(String, NodeId)>,
+    /// Variable and parameter names.
+    pub names: Names,
+    /// Number of variables.
+    pub n_vars: usize,
+    /// Number of parameters.
+    pub n_params: usize,
+    /// Counts of U, θ, φ as built.
+    pub before: Counts,
+    /// Counts of U, θ, φ after simplification.
+    pub after: Counts,
+    /// Counts of the printed values.
+    pub values: Counts,
+    /// Counts of the printed values and gradients (with `--gradient`).
+    pub with_gradients: Option<Counts>,
+    /// The simplifier's report.
+    pub report: simplify::Report,
+}
+
+/// Build the formulas `args` asks for.
+pub fn formulas(args: &FormulasArgs) -> Result<Formulas> {
     let spec = VertexSpec::parse(&args.spec).context("invalid vertex")?;
     let model = VertexModel::build(&spec, args.symbolic_sectors);
     let named = model.outputs();
@@ -66,7 +94,6 @@ pub fn render(args: &FormulasArgs) -> Result<String> {
     let (simplified, s_ids, report) = simplify::simplify(&graph, &ids, &Limits::default());
     let after = simplified.counts(&s_ids);
 
-    // The graph that is printed, and its outputs.
     let (mut g, mut outs): (ExprGraph, Vec<NodeId>) = if args.simplify {
         (simplified, s_ids)
     } else {
@@ -74,7 +101,7 @@ pub fn render(args: &FormulasArgs) -> Result<String> {
     };
     let mut names: Vec<String> = named.iter().map(|(n, _)| n.clone()).collect();
     let values = g.counts(&outs);
-    let mut with_grad: Option<Counts> = None;
+    let mut with_gradients: Option<Counts> = None;
     if args.gradient {
         let phis: Vec<NodeId> = outs[6..9].to_vec();
         let grads = gradients(&mut g, &phis, model.n_vars)?;
@@ -84,12 +111,30 @@ pub fn render(args: &FormulasArgs) -> Result<String> {
                 outs.push(d);
             }
         }
-        with_grad = Some(g.counts(&outs));
+        with_gradients = Some(g.counts(&outs));
     }
-    let outputs: Vec<(String, NodeId)> = names.into_iter().zip(outs).collect();
-    let format: Format = args.format.into();
-    let body = print(&g, &outputs, &model.names, format);
+    Ok(Formulas {
+        spec,
+        graph: g,
+        outputs: names.into_iter().zip(outs).collect(),
+        names: model.names,
+        n_vars: model.n_vars,
+        n_params: model.n_params,
+        before,
+        after,
+        values,
+        with_gradients,
+        report,
+    })
+}
 
+/// The formulas (and counts, as comments) as text in the requested format.
+pub fn render(args: &FormulasArgs) -> Result<String> {
+    let f = formulas(args)?;
+    let format: Format = args.format.into();
+    let body = print(&f.graph, &f.outputs, &f.names, format);
+    let (spec, before, after, values, report) = (&f.spec, f.before, f.after, f.values, &f.report);
+    let model_names = &f.names;
     let comment = match format {
         Format::Plain | Format::Python => "# ",
         Format::Latex => "% ",
@@ -102,8 +147,8 @@ pub fn render(args: &FormulasArgs) -> Result<String> {
         format!("vertex {spec}"),
         format!(
             "variables: {}; parameters: {}",
-            model.names.vars.join(", "),
-            model.names.params.join(", ")
+            model_names.vars.join(", "),
+            model_names.params.join(", ")
         ),
         format!(
             "U, theta, phi as built: {} nodes, {} operations ({} calls)",
@@ -126,7 +171,7 @@ pub fn render(args: &FormulasArgs) -> Result<String> {
             values.ops
         ),
     ];
-    if let Some(c) = with_grad {
+    if let Some(c) = f.with_gradients {
         head.push(format!(
             "with the gradients of phi1..3: {} nodes, {} operations",
             c.nodes, c.ops

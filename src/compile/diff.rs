@@ -17,6 +17,11 @@
 //!
 //! The guards are [`Node::Select`] nodes: both branches are evaluated and the discarded
 //! one may be infinite, which is harmless (no traps, no NaN reaches the result).
+//!
+//! Limitation: a `select` in the *forward* graph sends a zero adjoint into the branch it
+//! discards; if a value in that branch is NaN or infinite, `0 · NaN` makes the gradient
+//! NaN although the value is finite (forward mode would not). The kinematics never
+//! discards a non-finite branch (its only forward selects are `max(0, x)`).
 
 use crate::expr::{ExprGraph, Node, NodeId, ShapeError, check_indices};
 

@@ -240,6 +240,17 @@ impl ExprGraph {
                     }
                     (None, None) => {}
                 }
+                // A negative constant factor becomes a negation outside (exact): `-2·x`
+                // and `2·x` share, and `y + (-2)·x` becomes `y - 2·x`.
+                for (k, x) in [(a, b), (b, a)] {
+                    if let Some(c) = self.const_value(k)
+                        && c < 0.0
+                    {
+                        let pos = self.constant(-c);
+                        let m = self.add(Mul(pos, x));
+                        return self.add(Neg(m));
+                    }
+                }
                 // Constants first, then by id.
                 let (a, b) = match (self.const_value(a), self.const_value(b)) {
                     (None, Some(_)) => (b, a),
@@ -263,6 +274,19 @@ impl ExprGraph {
                     {
                         let k = self.constant(inv);
                         return self.add(Mul(k, a));
+                    }
+                }
+                for (k, first) in [(a, true), (b, false)] {
+                    if let Some(c) = self.const_value(k)
+                        && c < 0.0
+                    {
+                        let pos = self.constant(-c);
+                        let d = if first {
+                            self.add(Div(pos, b))
+                        } else {
+                            self.add(Div(a, pos))
+                        };
+                        return self.add(Neg(d));
                     }
                 }
                 match (self.neg_of(a), self.neg_of(b)) {
