@@ -49,7 +49,13 @@ type Instr = (u8, usize, usize, usize, f64);
 
 fn program() -> impl Strategy<Value = Vec<Instr>> {
     prop::collection::vec(
-        (0u8..15, any::<usize>(), any::<usize>(), any::<usize>(), -3.0f64..3.0),
+        (
+            0u8..15,
+            any::<usize>(),
+            any::<usize>(),
+            any::<usize>(),
+            -3.0f64..3.0,
+        ),
         1..25,
     )
 }

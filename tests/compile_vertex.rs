@@ -40,7 +40,11 @@ fn random_spec(rng: &mut ChaCha8Rng, n: usize) -> VertexSpec {
             .map(|_| DriveExpr::parse(if rng.random_bool(0.5) { "t" } else { "-t" }).unwrap())
             .collect(),
     });
-    let mode = if rng.random_bool(0.5) { Mode::Up } else { Mode::Down };
+    let mode = if rng.random_bool(0.5) {
+        Mode::Up
+    } else {
+        Mode::Down
+    };
     VertexSpec { mode, units }
 }
 
@@ -190,18 +194,20 @@ fn gradients_match_central_differences_where_smooth() {
                 continue;
             }
             tested += 1;
-            for i in 0..x.len() {
+            for (i, g) in grad.iter().enumerate() {
                 let d = fd(1e-6, i);
                 assert!(
-                    close(grad[i], d, 1e-6),
-                    "{spec}: d phi_sum / d alpha{}: {} vs central {d}",
-                    i + 1,
-                    grad[i]
+                    close(*g, d, 1e-6),
+                    "{spec}: d phi_sum / d alpha{}: {g} vs central {d}",
+                    i + 1
                 );
             }
         }
     }
-    assert!(tested * 2 >= total, "only {tested} of {total} points were smooth");
+    assert!(
+        tested * 2 >= total,
+        "only {tested} of {total} points were smooth"
+    );
 }
 
 #[test]

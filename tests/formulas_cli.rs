@@ -28,7 +28,10 @@ fn args(spec: &str, simplify: bool, gradient: bool, symbolic: bool) -> FormulasA
 
 /// Why the Python check cannot run here, if it cannot.
 fn python_unavailable() -> Option<String> {
-    match Command::new("python3").args(["-c", "import numpy"]).output() {
+    match Command::new("python3")
+        .args(["-c", "import numpy"])
+        .output()
+    {
         Err(e) => Some(format!("python3 not runnable: {e}")),
         Ok(o) if !o.status.success() => Some("numpy is not installed".to_string()),
         Ok(_) => None,
@@ -60,7 +63,11 @@ fn check_python(spec: &str, simplify: bool, gradient: bool, symbolic: bool) {
         cli.push("--symbolic-sectors");
     }
     let out = foldsynth(&cli);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("formulas.py");
     std::fs::write(&file, &out.stdout).unwrap();
@@ -90,7 +97,11 @@ fn check_python(spec: &str, simplify: bool, gradient: bool, symbolic: bool) {
         .args(["-c", RUNNER, file.to_str().unwrap(), &json])
         .output()
         .unwrap();
-    assert!(run.status.success(), "python: {}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success(),
+        "python: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     let got: Vec<Vec<f64>> = serde_json::from_slice(&run.stdout).unwrap();
     for ((x, p), py) in points.iter().zip(&got) {
         let mut want = vec![0.0; ids.len()];
@@ -141,9 +152,15 @@ fn formats_and_counts() {
     assert!(m.starts_with("(* vertex"), "{m}");
     assert!(m.contains("phi1 = "), "{m}");
     let l = run("latex", &[]);
-    assert!(l.contains("\\begin{aligned}") && l.contains("\\phi_{1} &= "), "{l}");
+    assert!(
+        l.contains("\\begin{aligned}") && l.contains("\\phi_{1} &= "),
+        "{l}"
+    );
     let d = run("dot", &[]);
-    assert!(d.contains("digraph expr {") && d.trim_end().ends_with('}'), "{d}");
+    assert!(
+        d.contains("digraph expr {") && d.trim_end().ends_with('}'),
+        "{d}"
+    );
 
     // Counts are real: simplification shrinks this vertex.
     let f = formulas(&args(V7, true, true, true)).unwrap();

@@ -219,20 +219,40 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
             black_box(&buf);
         }));
         rows[2].push(time_ns(slice, || {
-            tape.eval_with(&mut scratch, black_box(&vars), black_box(&params), &mut tbuf)
-                .expect("lengths checked above");
+            tape.eval_with(
+                &mut scratch,
+                black_box(&vars),
+                black_box(&params),
+                &mut tbuf,
+            )
+            .expect("lengths checked above");
             black_box(&tbuf);
         }));
         rows[3].push(time_ns(slice, || {
-            black_box(vertex::phi_sum(&spec, sym, black_box(&vars), black_box(&params)));
+            black_box(vertex::phi_sum(
+                &spec,
+                sym,
+                black_box(&vars),
+                black_box(&params),
+            ));
         }));
         rows[4].push(time_ns(slice, || {
-            black_box(vertex::phi_sum(&spec, sym, black_box(&vars), black_box(&params)));
+            black_box(vertex::phi_sum(
+                &spec,
+                sym,
+                black_box(&vars),
+                black_box(&params),
+            ));
             black_box(central(black_box(&vars)));
         }));
         rows[5].push(time_ns(slice, || {
             let dv: Vec<Dual> = (0..n).map(|i| Dual::var(vars[i], i, n)).collect();
-            black_box(vertex::phi_sum(&spec, sym, black_box(&dv), black_box(&dparams)));
+            black_box(vertex::phi_sum(
+                &spec,
+                sym,
+                black_box(&dv),
+                black_box(&dparams),
+            ));
         }));
         if let Some(PeerSetup::Harness { argv, .. }) = &peer_setup
             && harness_error.is_none()
@@ -269,7 +289,11 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
                 info["value"] = last["value"].clone();
                 info["grad"] = last["grad"].clone();
             }
-            info["value_grad_ns"] = json!(if ns.is_empty() { None } else { Some(median(&mut ns)) });
+            info["value_grad_ns"] = json!(if ns.is_empty() {
+                None
+            } else {
+                Some(median(&mut ns))
+            });
             info["rounds"] = json!(rounds);
             Some(info)
         }
@@ -352,12 +376,12 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
         rep.input.calls, rep.simplified.calls
     );
     println!();
-    println!("{:<44} {:>12} {:>12}", "value + gradient", "ns/eval", "vs JIT");
+    println!(
+        "{:<44} {:>12} {:>12}",
+        "value + gradient", "ns/eval", "vs JIT"
+    );
     let row = |name: &str, ns: f64| {
-        println!(
-            "{name:<44} {ns:>12.1} {:>11.2}x",
-            ns / jit_value_grad_ns
-        );
+        println!("{name:<44} {ns:>12.1} {:>11.2}x", ns / jit_value_grad_ns);
     };
     row("JIT (Cranelift)", jit_value_grad_ns);
     row("DAG interpreter", interpreter_value_grad_ns);
@@ -375,9 +399,15 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     }
     println!();
     println!("{:<44} {:>12.1}", "JIT value only (ns)", jit_value_ns);
-    println!("{:<44} {:>12.1}", "f64 kinematics value only (ns)", f64_value_ns);
+    println!(
+        "{:<44} {:>12.1}",
+        "f64 kinematics value only (ns)", f64_value_ns
+    );
     println!("{:<44} {:>12.2}", "JIT gradient/value cost ratio", ratio);
-    println!("{:<44} {:>12.1}", "JIT speedup over central differences", fd_speedup);
+    println!(
+        "{:<44} {:>12.1}",
+        "JIT speedup over central differences", fd_speedup
+    );
     println!();
     println!(
         "compile latency {compile_ms:.2} ms = build {build_ms:.2} + simplify {:.2} + differentiate {:.2} + JIT {:.2} (+ overhead)",
@@ -395,7 +425,9 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
         "checks: value vs f64/interpreter {max_dev_value:.1e}, gradient vs dual {max_dev_dual:.1e}, vs central differences {max_dev_fd:.1e}"
     );
     if let Some(d) = peer_dev {
-        println!("CasADi's value and gradient vs ours: {d:.1e} (NaN: CasADi's gradient is not guarded)");
+        println!(
+            "CasADi's value and gradient vs ours: {d:.1e} (NaN: CasADi's gradient is not guarded)"
+        );
     }
     Ok(())
 }
@@ -416,7 +448,10 @@ fn casadi_setup(args: &VertexBenchArgs, spec: &VertexSpec, t: f64) -> Result<Pee
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("benches/peers/casadi_vertex.py")
     });
     if !script.exists() {
-        bail!("peer script {} not found (use --peer-script)", script.display());
+        bail!(
+            "peer script {} not found (use --peer-script)",
+            script.display()
+        );
     }
     let units: Vec<_> = spec
         .units
@@ -439,10 +474,7 @@ fn casadi_setup(args: &VertexBenchArgs, spec: &VertexSpec, t: f64) -> Result<Pee
     let stamp = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_nanos());
-    let dir = std::env::temp_dir().join(format!(
-        "foldsynth-casadi-{}-{stamp}",
-        std::process::id()
-    ));
+    let dir = std::env::temp_dir().join(format!("foldsynth-casadi-{}-{stamp}", std::process::id()));
     let out = std::process::Command::new("python3")
         .arg(&script)
         .arg("--vertex-json")
@@ -491,7 +523,10 @@ fn run_harness(argv: &[String]) -> Result<serde_json::Value> {
         .output()
         .with_context(|| format!("cannot run the peer harness {}", argv[0]))?;
     if !out.status.success() {
-        bail!("peer harness failed: {}", String::from_utf8_lossy(&out.stderr).trim());
+        bail!(
+            "peer harness failed: {}",
+            String::from_utf8_lossy(&out.stderr).trim()
+        );
     }
     let text = String::from_utf8_lossy(&out.stdout);
     serde_json::from_str(text.lines().last().unwrap_or(""))

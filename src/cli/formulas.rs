@@ -141,7 +141,11 @@ pub fn render(args: &FormulasArgs) -> Result<String> {
         Format::Mathematica => "(* ",
         Format::Dot => "// ",
     };
-    let end = if format == Format::Mathematica { " *)" } else { "" };
+    let end = if format == Format::Mathematica {
+        " *)"
+    } else {
+        ""
+    };
     let pct = |a: usize, b: usize| 100.0 * (a as f64 - b as f64) / a.max(1) as f64;
     let mut head = vec![
         format!("vertex {spec}"),
@@ -166,7 +170,11 @@ pub fn render(args: &FormulasArgs) -> Result<String> {
         ),
         format!(
             "printed ({}): {} nodes, {} operations",
-            if args.simplify { "simplified" } else { "as built" },
+            if args.simplify {
+                "simplified"
+            } else {
+                "as built"
+            },
             values.nodes,
             values.ops
         ),

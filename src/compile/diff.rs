@@ -84,8 +84,8 @@ fn sweep(g: &mut ExprGraph, output: NodeId, n_vars: usize) -> Vec<NodeId> {
     for i in 0..n {
         if mark[i] {
             let node = g.node(NodeId(i as u32));
-            dep[i] = matches!(node, Node::Var(_))
-                || node.children().into_iter().any(|c| dep[c.index()]);
+            dep[i] =
+                matches!(node, Node::Var(_)) || node.children().into_iter().any(|c| dep[c.index()]);
         }
     }
     let mut grad: Vec<Option<NodeId>> = vec![None; n_vars];
@@ -244,9 +244,9 @@ mod tests {
             let d = f(Dual::var(x, 0, 2), Dual::var(y, 1, 2));
             let mut r = [0.0; 2];
             tape.eval(&[x, y], &[], &mut r).unwrap();
-            for k in 0..2 {
-                let e = (r[k] - d.g[k]).abs() / d.g[k].abs().max(1.0);
-                assert!(e < 1e-12, "({x}, {y}) d{k}: {} vs {}", r[k], d.g[k]);
+            for (k, (got, want)) in r.iter().zip(&d.g).enumerate() {
+                let e = (got - want).abs() / want.abs().max(1.0);
+                assert!(e < 1e-12, "({x}, {y}) d{k}: {got} vs {want}");
             }
         }
     }
@@ -255,7 +255,13 @@ mod tests {
     fn guarded_derivatives_are_zero_not_nan() {
         let ctx = Ctx::new();
         let x = ctx.var(0);
-        let outs = [x.acos(), x.sqrt(), x.sgn(), x.atan2(&Sym::from_f64(0.0)), x.clamp_unit()];
+        let outs = [
+            x.acos(),
+            x.sqrt(),
+            x.sgn(),
+            x.atan2(&Sym::from_f64(0.0)),
+            x.clamp_unit(),
+        ];
         let ids: Vec<NodeId> = outs.iter().map(|s| ctx.node_id(s)).collect();
         let mut g = ctx.to_graph();
         let grads: Vec<NodeId> = gradients(&mut g, &ids, 1)

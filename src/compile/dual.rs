@@ -52,7 +52,8 @@ impl Dual {
                 let n = a.len().max(b.len());
                 (0..n)
                     .map(|i| {
-                        ka * a.get(i).copied().unwrap_or(0.0) + kb * b.get(i).copied().unwrap_or(0.0)
+                        ka * a.get(i).copied().unwrap_or(0.0)
+                            + kb * b.get(i).copied().unwrap_or(0.0)
                     })
                     .collect()
             }
@@ -68,7 +69,11 @@ impl Dual {
 
     /// `clamp(self, -1, 1)`, derivative 1 inside the open interval and 0 elsewhere.
     pub fn clamp_unit(&self) -> Dual {
-        let d = if self.v > -1.0 && self.v < 1.0 { 1.0 } else { 0.0 };
+        let d = if self.v > -1.0 && self.v < 1.0 {
+            1.0
+        } else {
+            0.0
+        };
         self.chain(clamp_unit(self.v), d)
     }
 }
@@ -182,7 +187,11 @@ impl Scalar for Dual {
     fn atan2(&self, x: &Self) -> Self {
         let (yv, xv) = (self.v, x.v);
         let r = xv * xv + yv * yv;
-        let (dy, dx) = if r > 0.0 { (xv / r, -yv / r) } else { (0.0, 0.0) };
+        let (dy, dx) = if r > 0.0 {
+            (xv / r, -yv / r)
+        } else {
+            (0.0, 0.0)
+        };
         Dual {
             v: yv.atan2(xv),
             g: Dual::lin(dy, &self.g, dx, &x.g),

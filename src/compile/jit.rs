@@ -8,13 +8,13 @@
 
 use crate::expr::{ExprGraph, FxHashMap, Node, NodeId, ShapeError, check_indices};
 use crate::kinematics::acos_clamped;
+use cranelift_codegen::Context;
 use cranelift_codegen::ir::condcodes::FloatCC;
 use cranelift_codegen::ir::{
     AbiParam, FuncRef, InstBuilder, MemFlagsData, Signature, StackSlotData, StackSlotKind,
     UserFuncName, Value, types,
 };
 use cranelift_codegen::settings::{self, Configurable};
-use cranelift_codegen::Context;
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{FuncId, Linkage, Module, default_libcall_names};
@@ -125,7 +125,14 @@ impl CompiledFn {
         flags.set("use_colocated_libcalls", "false").map_err(cg)?;
         // The IR is generated, not hand-written; verifying it costs compile time.
         flags
-            .set("enable_verifier", if cfg!(debug_assertions) { "true" } else { "false" })
+            .set(
+                "enable_verifier",
+                if cfg!(debug_assertions) {
+                    "true"
+                } else {
+                    "false"
+                },
+            )
             .map_err(cg)?;
         let isa = cranelift_native::builder()
             .map_err(|e| CompileError::Host(e.to_string()))?
@@ -299,7 +306,8 @@ fn build(
             atan2: None,
             sincos: None,
         };
-        let slot = b.create_sized_stack_slot(StackSlotData::new(StackSlotKind::ExplicitSlot, 16, 3));
+        let slot =
+            b.create_sized_stack_slot(StackSlotData::new(StackSlotKind::ExplicitSlot, 16, 3));
         let mut slot_addr: Option<Value> = None;
         // Results of fused sincos calls, by argument node.
         let mut sincos_done: FxHashMap<NodeId, (Value, Value)> = FxHashMap::default();
@@ -327,7 +335,8 @@ fn build(
                         Some(&r) => r,
                         None => {
                             let f = import(&mut imports.sincos, ids[4], &mut b);
-                            let addr = *slot_addr.get_or_insert_with(|| b.ins().stack_addr(ptr, slot, 0));
+                            let addr =
+                                *slot_addr.get_or_insert_with(|| b.ins().stack_addr(ptr, slot, 0));
                             let s_ptr = addr;
                             let c_ptr = b.ins().iadd_imm_s(addr, 8);
                             let arg = v(a);
@@ -418,7 +427,12 @@ mod tests {
         let g = ctx.to_graph();
         let jit = CompiledFn::new(&g, &ids, 2, 1).unwrap();
         let tape = Tape::new(&g, &ids, 2, 1).unwrap();
-        for &(a, b, c) in &[(0.1, 0.2, 0.3), (-2.0, 5.0, 1.5), (0.0, 0.0, 0.0), (3.0, -1.0, -7.0)] {
+        for &(a, b, c) in &[
+            (0.1, 0.2, 0.3),
+            (-2.0, 5.0, 1.5),
+            (0.0, 0.0, 0.0),
+            (3.0, -1.0, -7.0),
+        ] {
             let mut r1 = [0.0; 3];
             let mut r2 = [0.0; 3];
             jit.call(&[a, b], &[c], &mut r1).unwrap();

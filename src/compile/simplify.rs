@@ -513,7 +513,11 @@ fn rebuild(
     roots: &[Id],
     best: impl Fn(Id) -> Option<Math>,
 ) -> Option<(ExprGraph, Vec<NodeId>)> {
-    let n = eg.classes().map(|c| usize::from(c.id)).max().map_or(0, |m| m + 1);
+    let n = eg
+        .classes()
+        .map(|c| usize::from(c.id))
+        .max()
+        .map_or(0, |m| m + 1);
     // 0 = unvisited, 1 = on the stack, 2 = done.
     let mut state = vec![0u8; n];
     let mut done: Vec<NodeId> = vec![NodeId(0); n];
@@ -575,7 +579,11 @@ fn tree_extract(eg: &EG, roots: &[Id]) -> Option<(ExprGraph, Vec<NodeId>)> {
 /// A node whose set would contain its own class is skipped (no cycles).
 fn dag_extract(eg: &EG, roots: &[Id]) -> Option<(ExprGraph, Vec<NodeId>)> {
     let classes: Vec<Id> = eg.classes().map(|c| c.id).collect();
-    let n_ids = classes.iter().map(|c| usize::from(*c)).max().map_or(0, |m| m + 1);
+    let n_ids = classes
+        .iter()
+        .map(|c| usize::from(*c))
+        .max()
+        .map_or(0, |m| m + 1);
     let mut dense = vec![usize::MAX; n_ids];
     for (k, c) in classes.iter().enumerate() {
         dense[usize::from(*c)] = k;
@@ -700,7 +708,10 @@ mod tests {
             let (mut r1, mut r2) = ([0.0], [0.0]);
             t1.eval(&[a, b], &[], &mut r1).unwrap();
             t2.eval(&[a, b], &[], &mut r2).unwrap();
-            assert!((r1[0] - r2[0]).abs() <= 1e-12 * r1[0].abs().max(1.0), "{r1:?} {r2:?}");
+            assert!(
+                (r1[0] - r2[0]).abs() <= 1e-12 * r1[0].abs().max(1.0),
+                "{r1:?} {r2:?}"
+            );
         }
     }
 }
@@ -719,6 +730,10 @@ mod max0_tests {
         let id = ctx.node_id(&y);
         let g = ctx.to_graph();
         let (s, outs, _) = simplify(&g, &[id], &Limits::default());
-        assert!(matches!(s.node(outs[0]), Node::Select(..)), "{:?}", s.nodes());
+        assert!(
+            matches!(s.node(outs[0]), Node::Select(..)),
+            "{:?}",
+            s.nodes()
+        );
     }
 }

@@ -131,12 +131,16 @@ impl ExprGraph {
 
     /// Variable `i`.
     pub fn var(&mut self, i: usize) -> NodeId {
-        self.intern(Node::Var(u32::try_from(i).expect("variable index fits u32")))
+        self.intern(Node::Var(
+            u32::try_from(i).expect("variable index fits u32"),
+        ))
     }
 
     /// Parameter `i`.
     pub fn param(&mut self, i: usize) -> NodeId {
-        self.intern(Node::Param(u32::try_from(i).expect("parameter index fits u32")))
+        self.intern(Node::Param(
+            u32::try_from(i).expect("parameter index fits u32"),
+        ))
     }
 
     fn is_const(&self, id: NodeId, c: f64) -> bool {
@@ -160,7 +164,10 @@ impl ExprGraph {
     pub fn add(&mut self, node: Node) -> NodeId {
         use Node::*;
         for c in node.children() {
-            assert!(c.index() < self.nodes.len(), "child {c:?} not in this graph");
+            assert!(
+                c.index() < self.nodes.len(),
+                "child {c:?} not in this graph"
+            );
         }
         // Every child constant: evaluate with the shared semantics.
         if !node.is_leaf() {
@@ -270,8 +277,7 @@ impl ExprGraph {
                 if let Some(c) = self.const_value(b) {
                     // Division by a power of two is multiplication by its exact inverse.
                     let inv = 1.0 / c;
-                    if c.is_finite() && c != 0.0 && is_power_of_two(c.abs()) && inv.is_finite()
-                    {
+                    if c.is_finite() && c != 0.0 && is_power_of_two(c.abs()) && inv.is_finite() {
                         let k = self.constant(inv);
                         return self.add(Mul(k, a));
                     }
@@ -432,7 +438,10 @@ impl ExprGraph {
                 if !n.is_leaf() {
                     c.ops += 1;
                 }
-                if matches!(n, Node::Sin(_) | Node::Cos(_) | Node::Acos(_) | Node::Atan2(..)) {
+                if matches!(
+                    n,
+                    Node::Sin(_) | Node::Cos(_) | Node::Acos(_) | Node::Atan2(..)
+                ) {
                     c.calls += 1;
                 }
             }

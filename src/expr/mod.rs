@@ -29,8 +29,8 @@ mod node;
 pub mod print;
 mod sym;
 
-pub use eval::{ShapeError, Tape};
 pub(crate) use eval::check_indices;
+pub use eval::{ShapeError, Tape};
 pub(crate) use graph::FxHashMap;
 pub use graph::{Counts, ExprGraph};
 pub use node::{Children, Node, NodeId, Range, clamp_unit, select};

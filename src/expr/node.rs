@@ -485,7 +485,11 @@ impl Range {
             return Range::of(&Node::Mul(NodeId(0), NodeId(0)), &[*x, *x]);
         }
         let (a, b) = (x.lo * x.lo, x.hi * x.hi);
-        let lo = if x.lo <= 0.0 && x.hi >= 0.0 { 0.0 } else { a.min(b) };
+        let lo = if x.lo <= 0.0 && x.hi >= 0.0 {
+            0.0
+        } else {
+            a.min(b)
+        };
         Range::interval(lo, a.max(b)).with_finite_check(lo, a.max(b))
     }
 

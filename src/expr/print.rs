@@ -202,7 +202,10 @@ impl Printer {
         let mut s = String::new();
         match self.format {
             Format::Plain => {
-                let _ = writeln!(s, "# acos(x) clamps x to [-1, 1]; select(c, a, b) = a if c > 0 else b");
+                let _ = writeln!(
+                    s,
+                    "# acos(x) clamps x to [-1, 1]; select(c, a, b) = a if c > 0 else b"
+                );
                 for (n, e) in stmts {
                     let _ = writeln!(s, "{n} = {e}");
                 }
@@ -301,7 +304,11 @@ impl Printer {
             let t = format!("{a:?}");
             match (f, t.split_once('e')) {
                 (Format::Mathematica, Some((m, e))) => {
-                    let m = if m.contains('.') { m.to_string() } else { format!("{m}.") };
+                    let m = if m.contains('.') {
+                        m.to_string()
+                    } else {
+                        format!("{m}.")
+                    };
                     format!("{m}*^{e}")
                 }
                 (Format::Latex, Some((m, e))) => format!("{m} \\times 10^{{{e}}}"),
@@ -409,8 +416,6 @@ fn paren(f: Format, x: &(String, u8), need: bool) -> String {
         x.0.clone()
     } else if f == Format::Latex {
         format!("\\left({}\\right)", x.0)
-    } else if f == Format::Mathematica {
-        format!("({})", x.0)
     } else {
         format!("({})", x.0)
     }
@@ -437,10 +442,10 @@ fn fname(f: Format, op: &'static str) -> &'static str {
 }
 
 const PY_RESERVED: &[&str] = &[
-    "np", "vars", "params", "out", "f", "False", "None", "True", "and", "as", "assert",
-    "async", "await", "break", "class", "continue", "def", "del", "elif", "else", "except",
-    "finally", "for", "from", "global", "if", "import", "in", "is", "lambda", "nonlocal",
-    "not", "or", "pass", "raise", "return", "try", "while", "with", "yield",
+    "np", "vars", "params", "out", "f", "False", "None", "True", "and", "as", "assert", "async",
+    "await", "break", "class", "continue", "def", "del", "elif", "else", "except", "finally",
+    "for", "from", "global", "if", "import", "in", "is", "lambda", "nonlocal", "not", "or", "pass",
+    "raise", "return", "try", "while", "with", "yield",
 ];
 
 // Single capital letters that are Mathematica built-ins.
@@ -592,7 +597,12 @@ mod tests {
         let x = g.var(0);
         let k = g.constant(1e-7);
         let m = g.add(Node::Mul(k, x));
-        let s = print(&g, &[("m".into(), m)], &Names::default(), Format::Mathematica);
+        let s = print(
+            &g,
+            &[("m".into(), m)],
+            &Names::default(),
+            Format::Mathematica,
+        );
         assert!(s.contains("1.*^-7 * x0"), "{s}");
     }
 }
