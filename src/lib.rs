@@ -15,7 +15,7 @@ pub mod export;
 pub mod expr;
 pub mod grammar;
 pub mod kinematics;
-// WIP pub mod model;
+pub mod model;
 pub mod optimize;
 pub mod pattern;
 pub mod search;

@@ -3,6 +3,8 @@
 use clap::{Parser, Subcommand};
 
 pub mod enumerate;
+pub mod bench;
+pub mod formulas;
 pub mod vertex;
 
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
@@ -21,6 +23,10 @@ pub enum Command {
     Vertex(vertex::VertexArgs),
     /// Generate every crease pattern graph of a task (rules r1, r2; thesis Table 3).
     Enumerate(enumerate::EnumerateArgs),
+    /// Benchmarks measured in one run (`foldsynth bench vertex …`).
+    Bench(bench::BenchArgs),
+    /// Symbolic formulas of U, θ, φ of a vertex (plain, LaTeX, Mathematica, Python, DOT).
+    Formulas(formulas::FormulasArgs),
 }
 
 /// Run one parsed command line.
@@ -28,5 +34,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Vertex(a) => vertex::run(a),
         Command::Enumerate(args) => enumerate::run(args),
+        Command::Bench(a) => bench::run(a),
+        Command::Formulas(a) => formulas::run(a),
     }
 }

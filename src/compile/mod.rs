@@ -1,1 +1,185 @@
 //! The compiler: egg simplification, reverse-mode differentiation, Cranelift JIT.
+//!
+//! A *model* is a set of outputs (objective, constraints, …) over variables and
+//! parameters in an [`ExprGraph`]. [`compile`] simplifies it, appends the gradient of
+//! every output with respect to all variables, and JIT-compiles values and gradients into
+//! one native call:
+//!
+//! ```
+//! use foldsynth::compile::{Options, compile};
+//! use foldsynth::expr::Ctx;
+//! use foldsynth::kinematics::Scalar;
+//!
+//! let ctx = Ctx::new();
+//! let (x, t) = (ctx.var(0), ctx.param(0));
+//! let f = (x.clone() * t).sin() + x.cos();
+//! let out = [ctx.node_id(&f)];
+//! let c = compile(&ctx.to_graph(), &out, 1, 1, &Options::default()).unwrap();
+//! let mut buf = vec![0.0; c.layout.len()];
+//! c.function.call(&[0.5], &[2.0], &mut buf).unwrap();
+//! assert!((buf[c.layout.value(0)] - (1.0f64.sin() + 0.5f64.cos())).abs() < 1e-15);
+//! let d = 2.0 * 1.0f64.cos() - 0.5f64.sin();
+//! assert!((buf[c.layout.gradient(0).start] - d).abs() < 1e-15);
+//! ```
+//!
+//! Stages: [`simplify`] (egg), [`diff`] (reverse mode), [`jit`] (Cranelift); [`dual`] is
+//! the forward-mode oracle the tests hold the differentiator to; [`vertex`] builds the
+//! symbolic PTU of one vertex (for `foldsynth formulas` and `foldsynth bench vertex`).
+
+pub mod diff;
+pub mod dual;
+pub mod jit;
+pub mod simplify;
+pub mod vertex;
+
+pub use diff::{gradient, gradients};
+pub use dual::Dual;
+pub use jit::{CompileError, CompiledFn};
+
+use crate::expr::{Counts, ExprGraph, NodeId, check_indices};
+use std::time::Instant;
+
+/// What [`compile`] does.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Simplify with egg first (`None`: only the construction-time folding).
+    pub simplify: Option<simplify::Limits>,
+    /// Append the gradient of every output with respect to all variables.
+    pub gradients: bool,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            simplify: Some(simplify::Limits::default()),
+            gradients: true,
+        }
+    }
+}
+
+/// Where things are in the output buffer of a compiled model: the values of the
+/// outputs first, then (with gradients) `n_vars` partial derivatives per output.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Layout {
+    /// Number of model outputs.
+    pub n_outputs: usize,
+    /// Number of variables.
+    pub n_vars: usize,
+    /// Whether gradients follow the values.
+    pub gradients: bool,
+}
+
+impl Layout {
+    /// Length of the output buffer.
+    pub fn len(&self) -> usize {
+        self.n_outputs * if self.gradients { 1 + self.n_vars } else { 1 }
+    }
+    /// Whether the buffer is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// Index of the value of output `i`.
+    pub fn value(&self, i: usize) -> usize {
+        i
+    }
+    /// Indices of the gradient of output `i` (empty without gradients).
+    pub fn gradient(&self, i: usize) -> std::ops::Range<usize> {
+        if self.gradients {
+            let s = self.n_outputs + i * self.n_vars;
+            s..s + self.n_vars
+        } else {
+            0..0
+        }
+    }
+}
+
+/// Sizes and times of the compiler stages.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CompileReport {
+    /// Counts of the model outputs as given.
+    pub input: Counts,
+    /// Counts after simplification (equal to `input` without it).
+    pub simplified: Counts,
+    /// Counts of values and gradients together (what is compiled).
+    pub with_gradients: Counts,
+    /// The simplifier's own report.
+    pub simplify: Option<simplify::Report>,
+    /// Milliseconds in simplification.
+    pub simplify_ms: f64,
+    /// Milliseconds in differentiation.
+    pub diff_ms: f64,
+    /// Milliseconds in code generation.
+    pub jit_ms: f64,
+}
+
+/// A compiled model.
+#[derive(Debug)]
+pub struct Compiled {
+    /// The native function.
+    pub function: CompiledFn,
+    /// Where values and gradients are in its output buffer.
+    pub layout: Layout,
+    /// The graph that was compiled.
+    pub graph: ExprGraph,
+    /// The compiled nodes, in the order of the output buffer.
+    pub outputs: Vec<NodeId>,
+    /// Sizes and times.
+    pub report: CompileReport,
+}
+
+/// Simplify, differentiate and compile `outputs` over `n_vars` variables and `n_params`
+/// parameters (see the module example).
+pub fn compile(
+    graph: &ExprGraph,
+    outputs: &[NodeId],
+    n_vars: usize,
+    n_params: usize,
+    opts: &Options,
+) -> Result<Compiled, CompileError> {
+    check_indices(graph, outputs, n_vars, n_params)?;
+    let input = graph.counts(outputs);
+    let t0 = Instant::now();
+    let (mut g, outs, srep) = match &opts.simplify {
+        Some(limits) => {
+            let (g, o, r) = simplify::simplify(graph, outputs, limits);
+            (g, o, Some(r))
+        }
+        None => {
+            let (g, o) = graph.extract(outputs);
+            (g, o, None)
+        }
+    };
+    let simplify_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let simplified = g.counts(&outs);
+    let t1 = Instant::now();
+    let mut all = outs.clone();
+    if opts.gradients {
+        for grad in gradients(&mut g, &outs, n_vars)? {
+            all.extend(grad);
+        }
+    }
+    let diff_ms = t1.elapsed().as_secs_f64() * 1e3;
+    let with_gradients = g.counts(&all);
+    let t2 = Instant::now();
+    let function = CompiledFn::new(&g, &all, n_vars, n_params)?;
+    let jit_ms = t2.elapsed().as_secs_f64() * 1e3;
+    Ok(Compiled {
+        function,
+        layout: Layout {
+            n_outputs: outputs.len(),
+            n_vars,
+            gradients: opts.gradients,
+        },
+        graph: g,
+        outputs: all,
+        report: CompileReport {
+            input,
+            simplified,
+            with_gradients,
+            simplify: srep,
+            simplify_ms,
+            diff_ms,
+            jit_ms,
+        },
+    })
+}

@@ -1,0 +1,204 @@
+//! Random expression DAGs (proptest): the interpreter equals a direct f64 evaluation of
+//! the same program, the JIT equals the interpreter, and reverse-mode gradients equal
+//! forward-mode dual numbers.
+
+use foldsynth::compile::{CompiledFn, Dual, gradients};
+use foldsynth::expr::{Ctx, NodeId, Sym, Tape, clamp_unit, select};
+use foldsynth::kinematics::Scalar;
+use proptest::prelude::*;
+
+/// The operations `Scalar` lacks but the graph has.
+trait Ext: Scalar {
+    fn select3(c: &Self, a: &Self, b: &Self) -> Self;
+    fn clamp1(&self) -> Self;
+}
+
+impl Ext for f64 {
+    fn select3(c: &Self, a: &Self, b: &Self) -> Self {
+        select(*c, *a, *b)
+    }
+    fn clamp1(&self) -> Self {
+        clamp_unit(*self)
+    }
+}
+
+impl Ext for Sym {
+    fn select3(c: &Self, a: &Self, b: &Self) -> Self {
+        Sym::select(c, a, b)
+    }
+    fn clamp1(&self) -> Self {
+        self.clamp_unit()
+    }
+}
+
+impl Ext for Dual {
+    fn select3(c: &Self, a: &Self, b: &Self) -> Self {
+        if c.v > 0.0 { a.clone() } else { b.clone() }
+    }
+    fn clamp1(&self) -> Self {
+        self.clamp_unit()
+    }
+}
+
+const N_VARS: usize = 3;
+const N_PARAMS: usize = 2;
+
+/// One instruction: an opcode, three operand picks (taken modulo the values so far) and
+/// a constant.
+type Instr = (u8, usize, usize, usize, f64);
+
+fn program() -> impl Strategy<Value = Vec<Instr>> {
+    prop::collection::vec(
+        (
+            0u8..15,
+            any::<usize>(),
+            any::<usize>(),
+            any::<usize>(),
+            -3.0f64..3.0,
+        ),
+        1..25,
+    )
+}
+
+/// Run the program in any scalar type; all values (inputs first).
+/// Denominators are `b² + 0.5` and atan2's x is `b² + 0.1` (both positive), so that no
+/// result depends on the sign of a zero (see `ExprGraph::add`).
+fn run_all<S: Ext>(prog: &[Instr], vars: &[S], params: &[S]) -> Vec<S> {
+    let mut v: Vec<S> = vars.iter().chain(params).cloned().collect();
+    for &(op, i, j, k, c) in prog {
+        let n = v.len();
+        let (a, b, d) = (v[i % n].clone(), v[j % n].clone(), v[k % n].clone());
+        let x = match op {
+            0 => a + b,
+            1 => a - b,
+            2 => a * b,
+            3 => a / (b.clone() * b + 0.5),
+            4 => -a,
+            5 => a.sin(),
+            6 => a.cos(),
+            7 => a.acos(),
+            8 => a.sqrt(),
+            9 => a.atan2(&(b.clone() * b + 0.1)),
+            10 => a.sgn() * b,
+            11 => S::select3(&a, &b, &d),
+            12 => a.clamp1(),
+            13 => a * c,
+            _ => a + c,
+        };
+        v.push(x);
+    }
+    v
+}
+
+/// The outputs: the last three values.
+fn run<S: Ext>(prog: &[Instr], vars: &[S], params: &[S]) -> Vec<S> {
+    let v = run_all(prog, vars, params);
+    v[v.len().saturating_sub(3)..].to_vec()
+}
+
+/// Whether every intermediate value is finite. Reverse mode sends a zero adjoint into
+/// the branch a `select` discards; if that branch holds a NaN, `0 · NaN` poisons the
+/// gradient (a documented limitation of `compile::diff`), so gradients are compared on
+/// programs whose every value is finite.
+fn all_finite(prog: &[Instr], x: &[f64], p: &[f64]) -> bool {
+    run_all(prog, x, p).iter().all(|v| v.is_finite())
+}
+
+fn same(a: f64, b: f64) -> bool {
+    // Numeric equality (±0 are equal), NaN equals NaN.
+    a == b || (a.is_nan() && b.is_nan())
+}
+
+fn inputs() -> impl Strategy<Value = (Vec<f64>, Vec<f64>)> {
+    (
+        prop::collection::vec(-2.0f64..2.0, N_VARS),
+        prop::collection::vec(-2.0f64..2.0, N_PARAMS),
+    )
+}
+
+fn build(prog: &[Instr]) -> (foldsynth::expr::ExprGraph, Vec<NodeId>) {
+    let ctx = Ctx::new();
+    let vars: Vec<Sym> = (0..N_VARS).map(|i| ctx.var(i)).collect();
+    let params: Vec<Sym> = (0..N_PARAMS).map(|i| ctx.param(i)).collect();
+    let outs = run(prog, &vars, &params);
+    let ids = outs.iter().map(|s| ctx.node_id(s)).collect();
+    (ctx.to_graph(), ids)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    #[test]
+    fn interpreter_jit_and_f64_agree(prog in program(), (x, p) in inputs()) {
+        let (g, ids) = build(&prog);
+        let direct = run(&prog, &x, &p);
+        let tape = Tape::new(&g, &ids, N_VARS, N_PARAMS).unwrap();
+        let jit = CompiledFn::new(&g, &ids, N_VARS, N_PARAMS).unwrap();
+        let mut ti = vec![0.0; ids.len()];
+        let mut tj = vec![0.0; ids.len()];
+        tape.eval(&x, &p, &mut ti).unwrap();
+        jit.call(&x, &p, &mut tj).unwrap();
+        for k in 0..ids.len() {
+            // Construction-time folding is exact, so the graph reproduces f64 exactly.
+            prop_assert!(same(ti[k], direct[k]), "interpreter {} vs f64 {} (output {k})", ti[k], direct[k]);
+            prop_assert!(same(tj[k], ti[k]), "JIT {} vs interpreter {} (output {k})", tj[k], ti[k]);
+        }
+    }
+
+    #[test]
+    fn reverse_mode_equals_dual_numbers(prog in program(), (x, p) in inputs()) {
+        prop_assume!(all_finite(&prog, &x, &p));
+        let (mut g, ids) = build(&prog);
+        let grads = gradients(&mut g, &ids, N_VARS).unwrap();
+        let flat: Vec<NodeId> = grads.iter().flatten().copied().collect();
+        let tape = Tape::new(&g, &flat, N_VARS, N_PARAMS).unwrap();
+        let mut r = vec![0.0; flat.len()];
+        tape.eval(&x, &p, &mut r).unwrap();
+        let dx: Vec<Dual> = (0..N_VARS).map(|i| Dual::var(x[i], i, N_VARS)).collect();
+        let dp: Vec<Dual> = p.iter().map(|&v| Dual::constant(v)).collect();
+        let d = run(&prog, &dx, &dp);
+        for (k, out) in d.iter().enumerate() {
+            if !out.v.is_finite() || out.g.iter().any(|v| !v.is_finite()) {
+                continue; // gradients of NaN values are not compared
+            }
+            let want = out.grad(N_VARS);
+            for i in 0..N_VARS {
+                let got = r[k * N_VARS + i];
+                let scale = got.abs().max(want[i].abs()).max(1.0);
+                prop_assert!(
+                    (got - want[i]).abs() <= 1e-10 * scale,
+                    "d out{k} / d x{i}: reverse {got} vs dual {}", want[i]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn gradients_are_never_nan_for_finite_values(prog in program(), (x, p) in inputs()) {
+        // Guarded derivatives: finite values never get a NaN gradient from sgn, acos
+        // outside (-1, 1), sqrt at 0, atan2, clamp or select.
+        prop_assume!(all_finite(&prog, &x, &p));
+        let (mut g, ids) = build(&prog);
+        let grads = gradients(&mut g, &ids, N_VARS).unwrap();
+        let tape_v = Tape::new(&g, &ids, N_VARS, N_PARAMS).unwrap();
+        let mut v = vec![0.0; ids.len()];
+        tape_v.eval(&x, &p, &mut v).unwrap();
+        let dx: Vec<Dual> = (0..N_VARS).map(|i| Dual::var(x[i], i, N_VARS)).collect();
+        let dp: Vec<Dual> = p.iter().map(|&q| Dual::constant(q)).collect();
+        let d = run(&prog, &dx, &dp);
+        for (k, grad) in grads.iter().enumerate() {
+            let tape = Tape::new(&g, grad, N_VARS, N_PARAMS).unwrap();
+            let mut r = vec![0.0; N_VARS];
+            tape.eval(&x, &p, &mut r).unwrap();
+            if v[k].is_finite() && d[k].g.iter().all(|q| q.is_finite()) {
+                prop_assert!(r.iter().all(|q| !q.is_nan()), "output {k}: {r:?}");
+            }
+        }
+    }
+}
+
+#[test]
+fn compiled_fn_is_send_and_sync() {
+    fn check<T: Send + Sync>() {}
+    check::<CompiledFn>();
+}
