@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 pub mod enumerate;
 pub mod bench;
 pub mod formulas;
+pub mod model;
 pub mod vertex;
 
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
@@ -27,6 +28,8 @@ pub enum Command {
     Bench(bench::BenchArgs),
     /// Symbolic formulas of U, θ, φ of a vertex (plain, LaTeX, Mathematica, Python, DOT).
     Formulas(formulas::FormulasArgs),
+    /// The optimization model of one graph: variables, constraints, compiled, verified.
+    Model(model::ModelArgs),
 }
 
 /// Run one parsed command line.
@@ -36,5 +39,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Enumerate(args) => enumerate::run(args),
         Command::Bench(a) => bench::run(a),
         Command::Formulas(a) => formulas::run(a),
+        Command::Model(a) => model::run(a),
     }
 }

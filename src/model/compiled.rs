@@ -5,7 +5,6 @@
 use super::Model;
 use crate::compile::{self, Compiled, Options};
 use crate::expr::{Ctx, Sym};
-use crate::kinematics::Scalar;
 use crate::optimize::{Evaluation, Problem};
 use std::cell::RefCell;
 use std::time::Instant;
@@ -152,7 +151,3 @@ pub fn outputs_f64(model: &Model, free: &[f64], modes: &[f64]) -> (f64, Vec<f64>
     let out = model.outputs(&vars, modes, &times);
     (out.objective, out.constraints)
 }
-
-/// Keep `Scalar` in scope for `full_vars` on symbols.
-#[allow(dead_code)]
-fn _assert_scalar<S: Scalar>() {}

@@ -7,6 +7,7 @@
 //! constraints ψ, and the choice of gripping vertex. The same code runs in `f64` (the
 //! numeric path that verification and export read) and on symbols (the compiled model).
 
+pub mod compiled;
 pub mod geometry;
 pub mod linalg;
 pub mod numeric;
@@ -144,8 +145,15 @@ impl Model {
         let out = self.outputs(&vars, &modes, &times);
         let mut ids = vec![ctx.node_id(&out.objective)];
         ids.extend(out.constraints.iter().map(|c| ctx.node_id(c)));
-        let used = ctx.graph().vars_used(&ids);
-        all.into_iter().filter(|i| used.get(*i).copied().unwrap_or(false)).collect()
+        let graph = ctx.graph();
+        let reach = graph.reachable(&ids);
+        let mut used = vec![false; all.len()];
+        for (node, r) in graph.nodes().iter().zip(&reach) {
+            if let (true, crate::expr::Node::Var(i)) = (r, node) {
+                used[*i as usize] = true;
+            }
+        }
+        all.into_iter().filter(|i| used[*i]).collect()
     }
 
     /// Lower and upper bound of variable `i` (of `plan.variables`).
