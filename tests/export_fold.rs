@@ -400,3 +400,52 @@ fn malformed_files_name_the_field() {
         assert!(e.contains(what), "expected {what:?} in: {e}");
     }
 }
+
+#[test]
+fn frame_inheritance_is_resolved() {
+    // Frame 2 inherits frame 1's coordinates (not the key frame's) and states its own
+    // angles; frame 3 inherits without naming a parent (as Origami Simulator writes).
+    let text = r#"{
+      "vertices_coords": [[0,0],[1,0],[1,1],[0,1]],
+      "edges_vertices": [[0,1],[1,2],[2,3],[3,0],[3,1]],
+      "edges_assignment": ["B","B","B","B","V"],
+      "faces_vertices": [[0,1,3],[1,2,3]],
+      "file_frames": [
+        {"frame_parent": 0, "frame_inherit": true,
+         "vertices_coords": [[0,0,0],[1,0,0],[0.5,0.5,0.7071067811865476],[0,1,0]]},
+        {"frame_parent": 1, "frame_inherit": true, "edges_foldAngle": [0,0,0,0,90]},
+        {"frame_inherit": true, "edges_foldAngle": [0,0,0,0,0]}
+      ]}"#;
+    let f = FoldFile::parse(text, "inherit.fold").unwrap();
+    assert_eq!(f.frames[2].coords, f.frames[1].coords);
+    assert!(f.frames[2].fold_angles_own && !f.frames[1].fold_angles_own);
+    assert_eq!(f.frames[3].coords, f.frames[0].coords);
+    let r = verify(&f, &VerifyOptions::default());
+    assert!(r.ok, "{r}");
+    // Frame 1 states no angles of its own: nothing to compare there.
+    assert_eq!(r.frames[0].max_fold_angle_error_deg, None);
+    assert!(r.frames[1].max_fold_angle_error_deg.unwrap() < 1e-12);
+
+    let cyc = text.replace(
+        r#""frame_parent": 0, "frame_inherit": true,"#,
+        r#""frame_parent": 2, "frame_inherit": true,"#,
+    );
+    let e = FoldFile::parse(&cyc, "cycle.fold").unwrap_err().to_string();
+    assert!(e.contains("cycle"), "{e}");
+}
+
+#[test]
+fn faces_with_a_repeated_vertex_are_derived() {
+    // A square with a dangling crease from the corner (0,0) to the centre: the derived
+    // face walks the slit on both sides and visits vertex 0 twice.
+    let text = r#"{"vertices_coords": [[0,0],[1,0],[1,1],[0,1],[0.5,0.5]],
+      "edges_vertices": [[0,1],[1,2],[2,3],[3,0],[0,4]],
+      "edges_assignment": ["B","B","B","B","F"]}"#;
+    let f = FoldFile::parse(text, "slit.fold").unwrap();
+    assert_eq!(f.faces.len(), 1);
+    let mut face = f.faces[0].clone();
+    assert_eq!(face.len(), 6);
+    assert_eq!(face.iter().filter(|&&v| v == 0).count(), 2);
+    face.sort();
+    assert_eq!(face, vec![0, 0, 1, 2, 3, 4]);
+}

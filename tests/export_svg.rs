@@ -193,7 +193,7 @@ fn flat_pattern_without_frames_still_draws() {
     assert!(scene.png(None, (64, 64)).unwrap().starts_with(b"\x89PNG"));
     assert!(
         scene
-            .gif((64, 64), 5)
+            .gif((64, 64), 5, 10)
             .unwrap_err()
             .to_string()
             .contains("nothing to animate")

@@ -416,3 +416,27 @@ fn bad_design_files_get_clear_errors() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("--frame 3"), "{}", stderr(&o));
 }
+
+#[test]
+fn documented_design_file_exports_and_verifies() {
+    // tests/data/demo_gripper_design.json shows the design JSON `export` reads.
+    let design = format!(
+        "{}/tests/data/demo_gripper_design.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let d: DesignFile = serde_json::from_str(&std::fs::read_to_string(&design).unwrap()).unwrap();
+    assert!(d.meta.second_arm && d.meta.obstacle.is_some());
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.fold");
+    let o = run(&[
+        "export",
+        &design,
+        "--format",
+        "fold",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&["verify", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stdout(&o));
+}

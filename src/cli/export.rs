@@ -152,7 +152,7 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
                 mesh::to_stl_binary(&m)
             })?
         }
-        Format::Gif => write(render::Scene::new(p, meta, camera)?.gif(a.size, 8)?)?,
+        Format::Gif => write(render::Scene::new(p, meta, camera)?.gif(a.size, 8, 60)?)?,
         Format::Png => write(render::Scene::new(p, meta, camera)?.png(frame, a.size)?)?,
         Format::StateSvg => write(
             render::Scene::new(p, meta, camera)?

@@ -25,7 +25,8 @@
 //! ## What the reader accepts
 //!
 //! Any FOLD file: 2D or 3D coordinates, with or without `file_frames` (inheritance via
-//! `frame_parent`/`frame_inherit` is resolved), with or without `edges_foldAngle` (also the
+//! `frame_parent`/`frame_inherit` is resolved; `frame_inherit: true` without a
+//! `frame_parent` inherits from the key frame), with or without `edges_foldAngle` (also the
 //! pre-1.1 name `edges_foldAngles`, and `null` entries), `edges_assignment` or
 //! `faces_vertices`. Missing faces are derived from the planar graph of the key frame;
 //! missing edges from the faces' sides. Every folded frame is compared with the key frame
@@ -846,12 +847,9 @@ fn resolve_inheritance(
         };
         let mut merged = Map::new();
         if inherit {
-            let p = parent.ok_or_else(|| {
-                cx.err(
-                    format!("{prefix}frame_inherit"),
-                    "true, but frame_parent is missing",
-                )
-            })?;
+            // Inheriting without a parent has nothing to inherit from but the key frame;
+            // Origami Simulator's "FOLD series" export writes exactly that.
+            let p = parent.unwrap_or(0);
             merged = go(cx, raw, out, p, depth + 1)?;
             // Frame metadata describes the parent, not this frame.
             merged.retain(|k, _| !k.starts_with("frame_"));

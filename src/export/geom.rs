@@ -245,14 +245,13 @@ pub fn faces_of_planar_graph(
             if used.contains_key(&(u, v)) {
                 continue;
             }
-            let mut face = vec![u];
+            // Follow half-edges until the walk returns to (u, v): the rotation system
+            // makes "next half-edge" a permutation, so every walk closes.
+            let mut face = Vec::new();
             let (mut a, mut b) = (u, v);
             loop {
                 used.insert((a, b), true);
-                if b == u {
-                    break;
-                }
-                face.push(b);
+                face.push(a);
                 if face.len() > 2 * edges.len() + 2 {
                     return Err("face walk did not close (graph not planar?)".into());
                 }
@@ -263,8 +262,10 @@ pub fn faces_of_planar_graph(
                     .position(|&w| w == a)
                     .ok_or("broken adjacency")?;
                 let w = list[(pos + list.len() - 1) % list.len()];
-                a = b;
-                b = w;
+                (a, b) = (b, w);
+                if (a, b) == (u, v) {
+                    break;
+                }
             }
             faces.push(face);
         }

@@ -342,6 +342,8 @@ pub struct ExportOptions {
     pub gif: bool,
     /// Delay between GIF frames in hundredths of a second.
     pub gif_delay_cs: u16,
+    /// At most this many GIF frames (picked evenly over the pattern's frames).
+    pub gif_max_frames: usize,
     /// The camera of pictures and animation.
     pub camera: render::Camera,
     /// Binary STL (`true`) or ASCII STL (`false`).
@@ -359,6 +361,7 @@ impl Default for ExportOptions {
             picture_states: 4,
             gif: true,
             gif_delay_cs: 8,
+            gif_max_frames: 60,
             camera: render::Camera::default(),
             stl_binary: true,
         }
@@ -467,7 +470,10 @@ pub fn write_all(
     }
     if opts.gif && !pattern.frames.is_empty() {
         let gif = path("gif");
-        write_file(&gif, scene.gif(opts.image_size, opts.gif_delay_cs)?)?;
+        write_file(
+            &gif,
+            scene.gif(opts.image_size, opts.gif_delay_cs, opts.gif_max_frames)?,
+        )?;
         files.gif = Some(gif);
     }
     Ok(files)

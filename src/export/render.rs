@@ -457,23 +457,26 @@ impl<'a> Scene<'a> {
             .map_err(|e| ExportError::Image(e.to_string()))
     }
 
-    /// The motion over all frames as an animated GIF (looping, with a pause at the end and
-    /// a progress bar along the bottom edge). `delay_cs` is the frame delay in 1/100 s.
-    pub fn gif(&self, size: (u32, u32), delay_cs: u16) -> Result<Vec<u8>> {
+    /// The motion as an animated GIF (looping, with a pause at the end and a progress bar
+    /// along the bottom edge): at most `max_frames` frames, evenly picked over the
+    /// pattern's frames (first and last included). `delay_cs` is the frame delay in 1/100 s.
+    pub fn gif(&self, size: (u32, u32), delay_cs: u16, max_frames: usize) -> Result<Vec<u8>> {
         Self::check_size(size)?;
-        let n = self.pattern.frames.len();
-        if n == 0 {
+        let total = self.pattern.frames.len();
+        if total == 0 {
             return Err(ExportError::invalid(
                 "pattern.frames",
                 "empty: nothing to animate",
             ));
         }
+        let picked = super::picked_frames(total, max_frames.max(2));
+        let n = picked.len();
         let img = |e: gif::EncodingError| ExportError::Image(e.to_string());
         let mut enc =
             gif::Encoder::new(Vec::new(), size.0 as u16, size.1 as u16, &[]).map_err(img)?;
         enc.set_repeat(gif::Repeat::Infinite).map_err(img)?;
-        for k in 0..n {
-            let mut pm = self.pixmap(Some(k), size)?;
+        for (k, &frame_index) in picked.iter().enumerate() {
+            let mut pm = self.pixmap(Some(frame_index), size)?;
             let frac = if n > 1 {
                 k as f32 / (n - 1) as f32
             } else {
