@@ -146,7 +146,7 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
         "flat crease pattern",
         flat,
         if flat {
-            format!("frame 0 lies in z = 0 (max |z| = {max_z:.1e})")
+            format!("frame 0 lies in z = 0 (max |z| = {max_z:.2e})")
         } else {
             format!(
                 "frame 0 is not flat: max |z| = {max_z:.3e} (sheet size {size:.3}); verify needs the crease pattern as frame 0"
@@ -371,7 +371,7 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
         worst_dev.0 <= angle_tol_rad,
         match worst_dev.1 {
             Some(v) => format!(
-                "{} interior vertices; max |Σ sectors − 2π| = {:.2e} rad (vertex {v})",
+                "{} interior vertex(es); max |Σ sectors − 2π| = {:.2e} rad (vertex {v})",
                 interior.len(),
                 worst_dev.0
             ),
