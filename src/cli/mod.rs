@@ -7,6 +7,8 @@ pub mod bench;
 pub mod formulas;
 pub mod model;
 pub mod vertex;
+pub mod export;
+pub mod verify;
 
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
 #[derive(Debug, Parser)]
@@ -30,6 +32,10 @@ pub enum Command {
     Formulas(formulas::FormulasArgs),
     /// The optimization model of one graph: variables, constraints, compiled, verified.
     Model(model::ModelArgs),
+    /// Write one design (from a design JSON) as FOLD, SVG, OBJ, STL, GIF or PNG.
+    Export(export::ExportArgs),
+    /// Check a FOLD file: isometry of every folded frame, fold angles, face consistency.
+    Verify(verify::VerifyArgs),
 }
 
 /// Run one parsed command line.
@@ -40,5 +46,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(a) => bench::run(a),
         Command::Formulas(a) => formulas::run(a),
         Command::Model(a) => model::run(a),
+        Command::Export(a) => export::run(a),
+        Command::Verify(a) => verify::run(a),
     }
 }
