@@ -14,11 +14,11 @@
 use crate::kinematics::{closure_residual, wrap_angle};
 use crate::model::geometry::units;
 use crate::model::numeric::Evaluated;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// What verification found.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct VerifyReport {
     /// Worst relative distance error over every facet and sampled state.
     pub isometry_max: f64,
@@ -38,6 +38,10 @@ pub struct VerifyReport {
     pub min_margin_t: f64,
     /// Number of states swept.
     pub states: usize,
+    /// States on which every internal vertex is rigid with at least the geometry margin
+    /// (the geometric invariants are checked on these: a non-rigid state has no closed
+    /// configuration to check).
+    pub rigid_states: usize,
 }
 
 /// Tolerances of a passing verification.
@@ -53,41 +57,73 @@ pub struct Tolerances {
     pub fold_angle: f64,
     /// Rigid-foldability margin (radians) below which a state counts as not rigid.
     pub margin: f64,
+    /// Smallest margin at which the geometric invariants are checked: nearer to a
+    /// degenerate vertex triangle its angles move with √margin, so rounding alone gives
+    /// closure errors of 1e-16/√margin.
+    pub geometry_margin: f64,
 }
 
 impl Default for Tolerances {
     fn default() -> Self {
-        Tolerances { isometry: 1e-9, closure: 1e-10, developability: 1e-9, fold_angle: 1e-8, margin: 1e-9 }
+        Tolerances {
+            isometry: 1e-9,
+            closure: 1e-10,
+            developability: 1e-9,
+            fold_angle: 1e-8,
+            margin: 1e-12,
+            geometry_margin: 1e-12,
+        }
     }
 }
 
 impl VerifyReport {
     /// Whether every invariant holds within `tol` (rigidity over the whole motion included).
     pub fn passes(&self, tol: &Tolerances) -> bool {
+        self.geometry_passes(tol) && self.rigid_over_motion
+    }
+
+    /// Whether the geometric invariants (isometry, closure, developability, fold angles)
+    /// hold on every rigid state: if not, the model computed a wrong shape — a bug, not
+    /// a property of the design.
+    pub fn geometry_passes(&self, tol: &Tolerances) -> bool {
         self.isometry_max <= tol.isometry
             && self.closure_max <= tol.closure
             && self.developability_max <= tol.developability
             && self.fold_angle_max <= tol.fold_angle
-            && self.rigid_over_motion
     }
 
     /// The failed invariants, in words.
     pub fn failures(&self, tol: &Tolerances) -> Vec<String> {
         let mut out = Vec::new();
         if self.isometry_max > tol.isometry {
-            out.push(format!("isometry {:.3e} > {:.0e}", self.isometry_max, tol.isometry));
+            out.push(format!(
+                "isometry {:.3e} > {:.0e}",
+                self.isometry_max, tol.isometry
+            ));
         }
         if self.closure_max > tol.closure {
-            out.push(format!("closure {:.3e} > {:.0e}", self.closure_max, tol.closure));
+            out.push(format!(
+                "closure {:.3e} > {:.0e}",
+                self.closure_max, tol.closure
+            ));
         }
         if self.developability_max > tol.developability {
-            out.push(format!("developability {:.3e} > {:.0e}", self.developability_max, tol.developability));
+            out.push(format!(
+                "developability {:.3e} > {:.0e}",
+                self.developability_max, tol.developability
+            ));
         }
         if self.fold_angle_max > tol.fold_angle {
-            out.push(format!("fold angles {:.3e} > {:.0e}", self.fold_angle_max, tol.fold_angle));
+            out.push(format!(
+                "fold angles {:.3e} > {:.0e}",
+                self.fold_angle_max, tol.fold_angle
+            ));
         }
         if !self.rigid_over_motion {
-            out.push(format!("not rigid at t = {:.6} (margin {:.3e})", self.min_margin_t, self.min_margin));
+            out.push(format!(
+                "not rigid at t = {:.6} (margin {:.3e})",
+                self.min_margin_t, self.min_margin
+            ));
         }
         out
     }
@@ -125,6 +161,7 @@ pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyRep
         min_margin: f64::INFINITY,
         min_margin_t: 0.0,
         states: ts.len(),
+        rigid_states: 0,
     };
 
     // Developability on the flat coordinates.
@@ -135,7 +172,10 @@ pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyRep
         let n = v.rays.len();
         let mut sum = 0.0;
         for k in 0..n {
-            let (a, b) = (&flat.pos[v.rays[k].other], &flat.pos[v.rays[(k + 1) % n].other]);
+            let (a, b) = (
+                &flat.pos[v.rays[k].other],
+                &flat.pos[v.rays[(k + 1) % n].other],
+            );
             let o = &flat.pos[i];
             let (u, w) = ([a[0] - o[0], a[1] - o[1]], [b[0] - o[0], b[1] - o[1]]);
             let mut ang = (u[0] * w[1] - u[1] * w[0]).atan2(u[0] * w[0] + u[1] * w[1]);
@@ -151,6 +191,34 @@ pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyRep
     let flat3: Vec<[f64; 3]> = flat.pos.iter().map(|p| [p[0], p[1], 0.0]).collect();
     for (si, &t) in ts.iter().enumerate() {
         let folded = design.fold(t);
+        // Rigidity first: the geometry of a state is only defined where every vertex is.
+        let mut rigid = true;
+        let mut state_margin = f64::INFINITY;
+        for &a in &plan.internal {
+            let st = folded.states[a]
+                .as_ref()
+                .expect("internal vertices are solved");
+            let margin = st.margins.iter().copied().fold(f64::INFINITY, f64::min);
+            if margin < r.min_margin {
+                r.min_margin = margin;
+                r.min_margin_t = t;
+            }
+            if margin < -tol.margin {
+                rigid = false;
+            }
+            state_margin = state_margin.min(margin);
+        }
+        if !rigid {
+            r.rigid_over_motion = false;
+            if si + 1 == ts.len() {
+                r.rigid_at_tmax = false;
+            }
+            continue;
+        }
+        if state_margin < tol.geometry_margin {
+            continue;
+        }
+        r.rigid_states += 1;
         let x = design.coords(&folded);
         // Isometry, relative to each facet's size.
         for (poly, _) in &plan.polygons {
@@ -161,39 +229,43 @@ pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyRep
                 .fold(0.0, f64::max);
             for (ia, a) in poly.iter().enumerate() {
                 for b in &poly[ia + 1..] {
-                    let e = (dist(&x[*a], &x[*b]) - dist(&flat3[*a], &flat3[*b])).abs() / size.max(1e-300);
+                    let e = (dist(&x[*a], &x[*b]) - dist(&flat3[*a], &flat3[*b])).abs()
+                        / size.max(1e-300);
                     r.isometry_max = r.isometry_max.max(e);
                 }
             }
         }
-        // Closure and rigidity at every internal vertex.
+        // Closure at every internal vertex.
+        let rho: Vec<Option<f64>> = folded.rho.iter().map(|x| Some(*x)).collect();
         for &a in &plan.internal {
-            let st = folded.states[a].as_ref().expect("internal vertices are solved");
-            let margin = st.margins.iter().copied().fold(f64::INFINITY, f64::min);
-            if margin < r.min_margin {
-                r.min_margin = margin;
-                r.min_margin_t = t;
-            }
-            if margin < -tol.margin {
-                r.rigid_over_motion = false;
-                if si + 1 == ts.len() {
-                    r.rigid_at_tmax = false;
-                }
-                continue;
-            }
-            let rho: Vec<Option<f64>> = folded.rho.iter().map(|x| Some(*x)).collect();
+            let st = folded.states[a]
+                .as_ref()
+                .expect("internal vertices are solved");
             if let Some(u) = units(plan, flat, &rho, a) {
                 r.closure_max = r.closure_max.max(closure_residual(&u, &st.phi));
             }
         }
-        // Fold angles against the facets' normals.
+        // Fold angles against the facets' normals, oriented like the facet in the flat
+        // state (an inverted facet is a layout defect the intersection check reports).
         let normals: Vec<Option<[f64; 3]>> = plan
             .polygons
             .iter()
-            .map(|(p, _)| (p.len() >= 3).then(|| normal(&p.iter().map(|v| x[*v]).collect::<Vec<_>>())))
+            .map(|(p, _)| {
+                (p.len() >= 3).then(|| {
+                    let n = normal(&p.iter().map(|v| x[*v]).collect::<Vec<_>>());
+                    let flat_n = normal(&p.iter().map(|v| flat3[*v]).collect::<Vec<_>>());
+                    if flat_n[2] < 0.0 {
+                        [-n[0], -n[1], -n[2]]
+                    } else {
+                        n
+                    }
+                })
+            })
             .collect();
         for (ci, c) in plan.creases.iter().enumerate() {
-            let (Some(nl), Some(nr)) = (normals[c.left], normals[c.right]) else { continue };
+            let (Some(nl), Some(nr)) = (normals[c.left], normals[c.right]) else {
+                continue;
+            };
             let e = {
                 let (p, q) = (&x[c.tail], &x[c.head]);
                 let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];

@@ -2,13 +2,14 @@
 
 use clap::{Parser, Subcommand};
 
-pub mod enumerate;
 pub mod bench;
+pub mod enumerate;
+pub mod export;
 pub mod formulas;
 pub mod model;
-pub mod vertex;
-pub mod export;
+pub mod synthesize;
 pub mod verify;
+pub mod vertex;
 
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
 #[derive(Debug, Parser)]
@@ -22,6 +23,8 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Run the whole method on a design task: enumerate, optimize, check, verify, export.
+    Synthesize(synthesize::SynthesizeArgs),
     /// The PTU for one vertex: unit, internal, start/end and dihedral angles over t.
     Vertex(vertex::VertexArgs),
     /// Generate every crease pattern graph of a task (rules r1, r2; thesis Table 3).
@@ -41,6 +44,7 @@ pub enum Command {
 /// Run one parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Command::Synthesize(a) => synthesize::run(a),
         Command::Vertex(a) => vertex::run(a),
         Command::Enumerate(args) => enumerate::run(args),
         Command::Bench(a) => bench::run(a),

@@ -57,7 +57,9 @@ pub struct ModelArgs {
 
 /// Parse "up,down,…" into ±1 for `n` internal vertices.
 pub fn parse_modes(text: Option<&str>, n: usize) -> Result<Vec<f64>> {
-    let Some(text) = text else { return Ok(vec![1.0; n]) };
+    let Some(text) = text else {
+        return Ok(vec![1.0; n]);
+    };
     let modes: Vec<f64> = text
         .split(',')
         .map(|m| match crate::kinematics::Mode::parse(m) {
@@ -66,33 +68,57 @@ pub fn parse_modes(text: Option<&str>, n: usize) -> Result<Vec<f64>> {
         })
         .collect::<Result<_>>()?;
     if modes.len() != n {
-        bail!("--modes: the graph has {n} internal vertices, {} modes were given", modes.len());
+        bail!(
+            "--modes: the graph has {n} internal vertices, {} modes were given",
+            modes.len()
+        );
     }
     Ok(modes)
 }
 
 /// Read variable values for the model's free variables from a JSON file.
 pub fn read_vars(model: &Model, path: &Path) -> Result<Vec<f64>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let v: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("{}: not valid JSON", path.display()))?;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let v: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not valid JSON", path.display()))?;
     let obj = v.get("variables").unwrap_or(&v);
-    let obj = obj
-        .as_object()
-        .with_context(|| format!("{}: expected an object {{\"name\": value, …}} of variables", path.display()))?;
+    let obj = obj.as_object().with_context(|| {
+        format!(
+            "{}: expected an object {{\"name\": value, …}} of variables",
+            path.display()
+        )
+    })?;
     let mut x = middle(model);
     for (name, value) in obj {
-        let Some(k) = model.free.iter().position(|&i| model.plan.variables[i].name == *name) else {
-            let known: Vec<&str> = model.free.iter().map(|&i| model.plan.variables[i].name.as_str()).collect();
-            bail!("{}: unknown variable '{name}'; this model's variables are {}", path.display(), known.join(", "));
+        let Some(k) = model
+            .free
+            .iter()
+            .position(|&i| model.plan.variables[i].name == *name)
+        else {
+            let known: Vec<&str> = model
+                .free
+                .iter()
+                .map(|&i| model.plan.variables[i].name.as_str())
+                .collect();
+            bail!(
+                "{}: unknown variable '{name}'; this model's variables are {}",
+                path.display(),
+                known.join(", ")
+            );
         };
-        let value = value
-            .as_f64()
-            .filter(|v| v.is_finite())
-            .with_context(|| format!("{}: variable '{name}' must be a finite number", path.display()))?;
+        let value = value.as_f64().filter(|v| v.is_finite()).with_context(|| {
+            format!(
+                "{}: variable '{name}' must be a finite number",
+                path.display()
+            )
+        })?;
         let (lo, hi) = model.var_bounds(model.free[k]);
         if !(lo..=hi).contains(&value) {
-            bail!("{}: variable '{name}' = {value} is outside its bounds [{lo}, {hi}]", path.display());
+            bail!(
+                "{}: variable '{name}' = {value} is outside its bounds [{lo}, {hi}]",
+                path.display()
+            );
         }
         x[k] = value;
     }
@@ -114,7 +140,8 @@ pub fn middle(model: &Model) -> Vec<f64> {
 /// Run `foldsynth model`.
 pub fn run(args: ModelArgs) -> Result<()> {
     let task = Task::load(&args.task)?;
-    let graph = CreaseGraph::from_sequence(&task, &args.graph).with_context(|| format!("--graph '{}'", args.graph))?;
+    let graph = CreaseGraph::from_sequence(&task, &args.graph)
+        .with_context(|| format!("--graph '{}'", args.graph))?;
     if !(1..=3).contains(&args.candidate) {
         bail!("--candidate must be 1, 2 or 3 (the successors of the vertex extended last)");
     }
@@ -153,23 +180,37 @@ pub fn run(args: ModelArgs) -> Result<()> {
     let full = model.full_vars(&x);
     let omega = model.omega(&full, &modes);
     let design = Evaluated::new(&model.plan, full.clone(), modes.clone());
-    let report = verify(&design, &sample_times(model.t_max, args.sweep.max(2)), &Tolerances::default());
+    let report = verify(
+        &design,
+        &sample_times(model.t_max, args.sweep.max(2)),
+        &Tolerances::default(),
+    );
     let rep = &compiled.compiled.report;
     let layout = &compiled.compiled.layout;
-    let constraint_values: Vec<f64> = (0..compiled.n_constraints).map(|k| buf[layout.value(k + 1)]).collect();
+    let constraint_values: Vec<f64> = (0..compiled.n_constraints)
+        .map(|k| buf[layout.value(k + 1)])
+        .collect();
     let gripping = model.plan.vertices[model.gripping].name;
 
     if let Some(fmt) = &args.formulas {
-        let format: Format = fmt.parse().map_err(|e| anyhow::anyhow!("--formulas: {e}"))?;
+        let format: Format = fmt
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--formulas: {e}"))?;
         let (ctx, outputs) = symbolic(&model);
         let mut named = vec![("objective".to_string(), ctx.node_id(&outputs[0]))];
         for (k, o) in outputs[1..].iter().enumerate() {
             named.push((format!("g{}", k + 1), ctx.node_id(o)));
         }
         let mut names = Names::default();
-        names.vars = model.free.iter().map(|&i| ascii_name(&model.plan.variables[i].name)).collect();
+        names.vars = model
+            .free
+            .iter()
+            .map(|&i| ascii_name(&model.plan.variables[i].name))
+            .collect();
         names.params = (0..n).map(|k| format!("M{}", k + 1)).collect();
-        names.params.extend((0..model.times.len()).map(|k| format!("t{k}")));
+        names
+            .params
+            .extend((0..model.times.len()).map(|k| format!("t{k}")));
         println!("{}", print(&ctx.graph(), &named, &names, format));
         return Ok(());
     }
@@ -211,17 +252,35 @@ pub fn run(args: ModelArgs) -> Result<()> {
         return Ok(());
     }
 
-    println!("model of {} for task '{}', gripping vertex v{gripping} (candidate {})", model.plan.sequence, task.name, args.candidate);
+    println!(
+        "model of {} for task '{}', gripping vertex v{gripping} (candidate {})",
+        model.plan.sequence, task.name, args.candidate
+    );
     println!(
         "internal vertices (extension order): {}  modes: {}",
-        model.plan.internal.iter().map(|v| format!("v{}", model.plan.vertices[*v].name)).collect::<Vec<_>>().join(", "),
-        modes.iter().map(|m| if *m > 0.0 { "up" } else { "down" }).collect::<Vec<_>>().join(", ")
+        model
+            .plan
+            .internal
+            .iter()
+            .map(|v| format!("v{}", model.plan.vertices[*v].name))
+            .collect::<Vec<_>>()
+            .join(", "),
+        modes
+            .iter()
+            .map(|m| if *m > 0.0 { "up" } else { "down" })
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     println!("\nvariables (Φ_opt):");
     for (k, &i) in model.free.iter().enumerate() {
         let v = &model.plan.variables[i];
         let (lo, hi) = model.var_bounds(i);
-        println!("  {:<10} {:<7} [{lo:.6}, {hi:.6}]  = {:.6}", v.name, kind(v.kind), x[k]);
+        println!(
+            "  {:<10} {:<7} [{lo:.6}, {hi:.6}]  = {:.6}",
+            v.name,
+            kind(v.kind),
+            x[k]
+        );
     }
     let dropped: Vec<&str> = model
         .plan
@@ -232,15 +291,27 @@ pub fn run(args: ModelArgs) -> Result<()> {
         .map(|(_, v)| v.name.as_str())
         .collect();
     if !dropped.is_empty() {
-        println!("  (influence nothing, drawn at their lower bound: {})", dropped.join(", "));
+        println!(
+            "  (influence nothing, drawn at their lower bound: {})",
+            dropped.join(", ")
+        );
     }
     println!("\nconstraints ψ (g ≥ 0), value at this point:");
     for (k, g) in constraint_values.iter().enumerate() {
-        println!("  {:>12.6}{}  {}", g, if *g < -1e-9 { " ✗" } else { "  " }, model.constraint_label(k));
+        println!(
+            "  {:>12.6}{}  {}",
+            g,
+            if *g < -1e-9 { " ✗" } else { "  " },
+            model.constraint_label(k)
+        );
     }
     println!(
         "\nexpression graph: {} operations as built, {} after egg, {} with all gradients; build {:.2} ms, build→native {:.2} ms",
-        rep.input.ops, rep.simplified.ops, rep.with_gradients.ops, compiled.build_ms, compiled.total_ms
+        rep.input.ops,
+        rep.simplified.ops,
+        rep.with_gradients.ops,
+        compiled.build_ms,
+        compiled.total_ms
     );
     println!(
         "objective Ω = {omega:.6e} (threshold {:.1e}; compiled objective {:.6e}, target {:.3e})",
@@ -248,7 +319,10 @@ pub fn run(args: ModelArgs) -> Result<()> {
         buf[layout.value(0)],
         objective_target(&model)
     );
-    println!("\nverification over {} states in [0, {:.6}]:", report.states, model.t_max);
+    println!(
+        "\nverification over {} states in [0, {:.6}]:",
+        report.states, model.t_max
+    );
     println!("  isometry max          {:.3e}", report.isometry_max);
     println!("  closure max           {:.3e}", report.closure_max);
     println!("  developability max    {:.3e}", report.developability_max);

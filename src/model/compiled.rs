@@ -71,7 +71,10 @@ impl CompiledModel {
 
     /// Evaluate into `out` (sized [`CompiledModel::buffer_len`]).
     pub fn call(&self, free: &[f64], params: &[f64], out: &mut [f64]) {
-        self.compiled.function.call(free, params, out).expect("buffer sizes match the compiled layout");
+        self.compiled
+            .function
+            .call(free, params, out)
+            .expect("buffer sizes match the compiled layout");
     }
 
     /// Length of the output buffer.

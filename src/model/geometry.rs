@@ -39,18 +39,30 @@ pub struct Folded<S> {
 
 /// Angle of the direction from `from` to `to` with an exact expression where the plan
 /// has one (placement angles) and `atan2` of the coordinates otherwise.
-fn direction_angle<S: Scalar>(plan: &Plan, pos: &[[S; 2]], ang: &[Option<S>], from: usize, to: usize) -> S {
-    if let (Position::Placed { parent, crease, .. }, Some(a)) = (&plan.vertices[to].position, &ang[to]) {
+fn direction_angle<S: Scalar>(
+    plan: &Plan,
+    pos: &[[S; 2]],
+    ang: &[Option<S>],
+    from: usize,
+    to: usize,
+) -> S {
+    if let (Position::Placed { parent, crease, .. }, Some(a)) =
+        (&plan.vertices[to].position, &ang[to])
+    {
         if *parent == from && plan.creases[*crease].head == to {
             return a.clone();
         }
     }
-    if let (Position::Placed { parent, crease, .. }, Some(a)) = (&plan.vertices[from].position, &ang[from]) {
+    if let (Position::Placed { parent, crease, .. }, Some(a)) =
+        (&plan.vertices[from].position, &ang[from])
+    {
         if *parent == to && plan.creases[*crease].head == from {
             return a.clone() + PI;
         }
     }
-    if let (Position::Fixed(p), Position::Fixed(q)) = (&plan.vertices[from].position, &plan.vertices[to].position) {
+    if let (Position::Fixed(p), Position::Fixed(q)) =
+        (&plan.vertices[from].position, &plan.vertices[to].position)
+    {
         return S::from_f64((q[1] - p[1]).atan2(q[0] - p[0]));
     }
     let dy = pos[to][1].clone() - pos[from][1].clone();
@@ -70,9 +82,18 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
                 pos.push([S::from_f64(xy[0]), S::from_f64(xy[1])]);
                 ang.push(None);
             }
-            Position::Placed { parent, reference, sign, sectors, length, .. } => {
+            Position::Placed {
+                parent,
+                reference,
+                sign,
+                sectors,
+                length,
+                ..
+            } => {
                 let base = direction_angle(plan, &pos, &ang, *parent, *reference);
-                let turn = sectors.iter().fold(S::from_f64(0.0), |acc, s| acc + vars[*s].clone());
+                let turn = sectors
+                    .iter()
+                    .fold(S::from_f64(0.0), |acc, s| acc + vars[*s].clone());
                 let a = base + turn * *sign;
                 let l = vars[*length].clone();
                 let p = [
@@ -92,10 +113,14 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
             .iter()
             .map(|r| {
                 let exact = match (&plan.vertices[r.other].position, &plan.vertices[i].position) {
-                    (Position::Placed { parent, crease, .. }, _) if r.outgoing && *parent == i && *crease == r.crease => {
+                    (Position::Placed { parent, crease, .. }, _)
+                        if r.outgoing && *parent == i && *crease == r.crease =>
+                    {
                         ang[r.other].clone()
                     }
-                    (_, Position::Placed { parent, crease, .. }) if !r.outgoing && *parent == r.other && *crease == r.crease => {
+                    (_, Position::Placed { parent, crease, .. })
+                        if !r.outgoing && *parent == r.other && *crease == r.crease =>
+                    {
                         ang[i].clone().map(|a| a + PI)
                     }
                     _ => None,
@@ -118,7 +143,9 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
             .enumerate()
             .map(|(k, rule)| match rule {
                 Sector::Linear(terms) => Some(
-                    terms.iter().fold(S::from_f64(0.0), |acc, (c, x)| acc + vars[*x].clone() * *c),
+                    terms
+                        .iter()
+                        .fold(S::from_f64(0.0), |acc, (c, x)| acc + vars[*x].clone() * *c),
                 ),
                 Sector::Constant(c) => Some(S::from_f64(*c)),
                 Sector::Remainder => None,
@@ -131,10 +158,17 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
             })
             .collect();
         if let Some(r) = v.sectors.iter().position(|x| *x == Sector::Remainder) {
-            let others = s.iter().flatten().fold(S::from_f64(0.0), |acc, x| acc + x.clone());
+            let others = s
+                .iter()
+                .flatten()
+                .fold(S::from_f64(0.0), |acc, x| acc + x.clone());
             s[r] = Some(S::from_f64(2.0 * PI) - others);
         }
-        sectors.push(s.into_iter().map(|x| x.expect("every sector computed")).collect());
+        sectors.push(
+            s.into_iter()
+                .map(|x| x.expect("every sector computed"))
+                .collect(),
+        );
         dirs.push(d);
     }
     Flat { pos, dirs, sectors }
@@ -142,7 +176,12 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
 
 /// The units of internal vertex `a` (Eq. 29): u1 = (s3→p1, p1→p2, …, pm→s1) driven by
 /// the incoming creases, u2 = (s1→s2), u3 = (s2→s3).
-pub fn units<S: Scalar>(plan: &Plan, flat: &Flat<S>, rho: &[Option<S>], a: usize) -> Option<[Unit<S>; 3]> {
+pub fn units<S: Scalar>(
+    plan: &Plan,
+    flat: &Flat<S>,
+    rho: &[Option<S>],
+    a: usize,
+) -> Option<[Unit<S>; 3]> {
     let v = &plan.vertices[a];
     let (m, n) = (v.preds, v.rays.len());
     let s = &flat.sectors[a];
@@ -152,16 +191,25 @@ pub fn units<S: Scalar>(plan: &Plan, flat: &Flat<S>, rho: &[Option<S>], a: usize
     for r in &v.rays[..m] {
         drive.push(rho[r.crease].clone()?);
     }
-    Some([Unit::new(u1, drive), Unit::single(s[m].clone()), Unit::single(s[m + 1].clone())])
+    Some([
+        Unit::new(u1, drive),
+        Unit::single(s[m].clone()),
+        Unit::single(s[m + 1].clone()),
+    ])
 }
 
 /// The folded state at `t` with rigid body modes `modes` (±1 per internal vertex, in the
 /// order of [`Plan::internal`]).
 pub fn fold<S: Scalar>(plan: &Plan, flat: &Flat<S>, modes: &[S], t: &S) -> Folded<S> {
-    let mut rho: Vec<Option<S>> = plan.creases.iter().map(|c| c.drive.as_ref().map(|d| d.eval(t))).collect();
+    let mut rho: Vec<Option<S>> = plan
+        .creases
+        .iter()
+        .map(|c| c.drive.as_ref().map(|d| d.eval(t)))
+        .collect();
     let mut states: Vec<Option<VertexState<S>>> = vec![None; plan.vertices.len()];
     for (k, &a) in plan.internal.iter().enumerate() {
-        let units = units(plan, flat, &rho, a).expect("incoming dihedral angles are known in extension order");
+        let units = units(plan, flat, &rho, a)
+            .expect("incoming dihedral angles are known in extension order");
         let st = solve_vertex(&units, &modes[k]);
         let v = &plan.vertices[a];
         let m = v.preds;
@@ -181,7 +229,10 @@ pub fn fold<S: Scalar>(plan: &Plan, flat: &Flat<S>, modes: &[S], t: &S) -> Folde
     let act = &plan.creases[plan.actuation.crease];
     let tail = &flat.pos[act.tail];
     let head = &flat.pos[act.head];
-    let (dx, dy) = (head[0].clone() - tail[0].clone(), head[1].clone() - tail[1].clone());
+    let (dx, dy) = (
+        head[0].clone() - tail[0].clone(),
+        head[1].clone() - tail[1].clone(),
+    );
     let len = (dx.clone() * dx.clone() + dy.clone() * dy.clone()).sqrt();
     let (dx, dy) = (dx / len.clone(), dy / len);
     let half = rho[plan.actuation.crease].clone() * 0.5;
@@ -202,7 +253,12 @@ pub fn fold<S: Scalar>(plan: &Plan, flat: &Flat<S>, modes: &[S], t: &S) -> Folde
         trans[step.facet] = linalg::sub(&xv, &linalg::apply(&r, &x));
         rot[step.facet] = r;
     }
-    Folded { rho, states, rot, trans }
+    Folded {
+        rho,
+        states,
+        rot,
+        trans,
+    }
 }
 
 /// 3D position of vertex `v` (read through its home facet).
@@ -212,6 +268,10 @@ pub fn position<S: Scalar>(plan: &Plan, flat: &Flat<S>, folded: &Folded<S>, v: u
 
 /// 3D position of vertex `v` read through facet `f`'s map.
 pub fn position_on<S: Scalar>(flat: &Flat<S>, folded: &Folded<S>, v: usize, f: usize) -> Vec3<S> {
-    let x: Vec3<S> = [flat.pos[v][0].clone(), flat.pos[v][1].clone(), S::from_f64(0.0)];
+    let x: Vec3<S> = [
+        flat.pos[v][0].clone(),
+        flat.pos[v][1].clone(),
+        S::from_f64(0.0),
+    ];
     linalg::add(&linalg::apply(&folded.rot[f], &x), &folded.trans[f])
 }

@@ -10,7 +10,11 @@ pub type Vec3<S> = [S; 3];
 /// The identity.
 pub fn identity<S: Scalar>() -> Mat3<S> {
     let (o, z) = (S::from_f64(1.0), S::from_f64(0.0));
-    [[o.clone(), z.clone(), z.clone()], [z.clone(), o.clone(), z.clone()], [z.clone(), z, o]]
+    [
+        [o.clone(), z.clone(), z.clone()],
+        [z.clone(), o.clone(), z.clone()],
+        [z.clone(), z, o],
+    ]
 }
 
 /// `a · b`.
@@ -27,7 +31,9 @@ pub fn mul<S: Scalar>(a: &Mat3<S>, b: &Mat3<S>) -> Mat3<S> {
 /// `a · v`.
 pub fn apply<S: Scalar>(a: &Mat3<S>, v: &Vec3<S>) -> Vec3<S> {
     std::array::from_fn(|i| {
-        a[i][0].clone() * v[0].clone() + a[i][1].clone() * v[1].clone() + a[i][2].clone() * v[2].clone()
+        a[i][0].clone() * v[0].clone()
+            + a[i][1].clone() * v[1].clone()
+            + a[i][2].clone() * v[2].clone()
     })
 }
 
@@ -48,8 +54,16 @@ pub fn rot_in_plane_axis<S: Scalar>(dx: &S, dy: &S, angle: &S) -> Mat3<S> {
     let z = S::from_f64(0.0);
     // R = c I + s [d]× + (1 − c) d dᵀ with d = (dx, dy, 0).
     [
-        [c.clone() + k.clone() * dx.clone() * dx.clone(), k.clone() * dx.clone() * dy.clone(), s.clone() * dy.clone()],
-        [k.clone() * dx.clone() * dy.clone(), c.clone() + k * dy.clone() * dy.clone(), -(s.clone() * dx.clone())],
+        [
+            c.clone() + k.clone() * dx.clone() * dx.clone(),
+            k.clone() * dx.clone() * dy.clone(),
+            s.clone() * dy.clone(),
+        ],
+        [
+            k.clone() * dx.clone() * dy.clone(),
+            c.clone() + k * dy.clone() * dy.clone(),
+            -(s.clone() * dx.clone()),
+        ],
         [-(s.clone() * dy.clone()), s * dx.clone(), c + z],
     ]
 }

@@ -48,6 +48,13 @@ pub struct Target {
 /// where a target is hit exactly. Far below any threshold a task can state.
 pub const DISTANCE_SMOOTHING: f64 = 1e-9;
 
+/// Eq. 33 is imposed with this margin (radians): `U_j + U_k − U_i ≥ RIGID_MARGIN` at
+/// t_max. At a margin of exactly 0 the vertex triangle is degenerate and its angles move
+/// with the square root of the margin, so rounding (1e-16) would become closure errors of
+/// 1e-8; a margin of 1e-8 keeps the optimized state strictly rigid and the computed
+/// geometry exact to ~1e-12, and changes no design measurably.
+pub const RIGID_MARGIN: f64 = 1e-8;
+
 /// An error building a model.
 #[derive(Debug, thiserror::Error)]
 pub enum ModelError {
@@ -97,17 +104,44 @@ impl Model {
 
     /// The model of an already built plan.
     pub fn from_plan(plan: Plan, task: &Task, candidate: usize) -> Result<Model, ModelError> {
-        let err = |message: &str| ModelError::Task { task: task.name.clone(), message: message.to_string() };
-        let b = task.bounds.as_ref().ok_or_else(|| err("the task has no [bounds] (l_min, l_max, alpha_min, alpha_max)"))?;
-        let bounds = Bounds { l_min: b.l_min, l_max: b.l_max, alpha_min: b.alpha_min, alpha_max: b.alpha_max };
-        let t_max = task.motion.as_ref().ok_or_else(|| err("the task has no [motion] t_max"))?.t_max;
-        let objective = task.objective.as_ref().ok_or_else(|| err("the task has no [objective] with targets"))?;
+        let err = |message: &str| ModelError::Task {
+            task: task.name.clone(),
+            message: message.to_string(),
+        };
+        let b = task
+            .bounds
+            .as_ref()
+            .ok_or_else(|| err("the task has no [bounds] (l_min, l_max, alpha_min, alpha_max)"))?;
+        let bounds = Bounds {
+            l_min: b.l_min,
+            l_max: b.l_max,
+            alpha_min: b.alpha_min,
+            alpha_max: b.alpha_max,
+        };
+        let t_max = task
+            .motion
+            .as_ref()
+            .ok_or_else(|| err("the task has no [motion] t_max"))?
+            .t_max;
+        let objective = task
+            .objective
+            .as_ref()
+            .ok_or_else(|| err("the task has no [objective] with targets"))?;
         if objective.targets.is_empty() {
             return Err(err("the objective has no targets"));
         }
-        let targets: Vec<Target> =
-            objective.targets.iter().map(|t| Target { t: t.t, point: t.point, weight: t.weight }).collect();
-        let candidates = plan.candidates.ok_or_else(|| err("the graph has no extended vertex to grip with"))?;
+        let targets: Vec<Target> = objective
+            .targets
+            .iter()
+            .map(|t| Target {
+                t: t.t,
+                point: t.point,
+                weight: t.weight,
+            })
+            .collect();
+        let candidates = plan
+            .candidates
+            .ok_or_else(|| err("the graph has no extended vertex to grip with"))?;
         if candidate > 2 {
             return Err(err("the gripping candidate must be 1, 2 or 3"));
         }
@@ -139,9 +173,12 @@ impl Model {
         let ctx = crate::expr::Ctx::new();
         let all: Vec<usize> = (0..self.plan.variables.len()).collect();
         let vars: Vec<crate::expr::Sym> = all.iter().map(|&i| ctx.var(i)).collect();
-        let modes: Vec<crate::expr::Sym> = (0..self.plan.internal.len()).map(|i| ctx.param(i)).collect();
-        let times: Vec<crate::expr::Sym> =
-            (0..self.times.len()).map(|i| ctx.param(self.plan.internal.len() + i)).collect();
+        let modes: Vec<crate::expr::Sym> = (0..self.plan.internal.len())
+            .map(|i| ctx.param(i))
+            .collect();
+        let times: Vec<crate::expr::Sym> = (0..self.times.len())
+            .map(|i| ctx.param(self.plan.internal.len() + i))
+            .collect();
         let out = self.outputs(&vars, &modes, &times);
         let mut ids = vec![ctx.node_id(&out.objective)];
         ids.extend(out.constraints.iter().map(|c| ctx.node_id(c)));
@@ -166,7 +203,9 @@ impl Model {
 
     /// The full variable vector from the free ones (the others at their lower bound).
     pub fn full_vars<S: Scalar>(&self, free: &[S]) -> Vec<S> {
-        let mut full: Vec<S> = (0..self.plan.variables.len()).map(|i| S::from_f64(self.var_bounds(i).0)).collect();
+        let mut full: Vec<S> = (0..self.plan.variables.len())
+            .map(|i| S::from_f64(self.var_bounds(i).0))
+            .collect();
         for (k, &i) in self.free.iter().enumerate() {
             full[i] = free[k].clone();
         }
@@ -177,10 +216,17 @@ impl Model {
     /// vertex) and the values of [`Model::times`] (as scalars, so they can be parameters).
     pub fn outputs<S: Scalar>(&self, vars: &[S], modes: &[S], times: &[S]) -> Outputs<S> {
         let flat = geometry::flat(&self.plan, vars);
-        let folded: Vec<Folded<S>> = times.iter().map(|t| geometry::fold(&self.plan, &flat, modes, t)).collect();
+        let folded: Vec<Folded<S>> = times
+            .iter()
+            .map(|t| geometry::fold(&self.plan, &flat, modes, t))
+            .collect();
         let mut terms = Vec::with_capacity(self.targets.len());
         for target in &self.targets {
-            let k = self.times.iter().position(|s| *s == target.t).expect("every target time is in times");
+            let k = self
+                .times
+                .iter()
+                .position(|s| *s == target.t)
+                .expect("every target time is in times");
             let x = geometry::position(&self.plan, &flat, &folded[k], self.gripping);
             let d2 = (0..3).fold(S::from_f64(0.0), |acc, i| {
                 let d = x[i].clone() - target.point[i];
@@ -198,7 +244,10 @@ impl Model {
             })
         };
         let constraints = self.constraints(&flat, &folded[0]);
-        Outputs { objective, constraints }
+        Outputs {
+            objective,
+            constraints,
+        }
     }
 
     /// The constraints ψ as `g ≥ 0`, in the order of `plan.constraints`; rigid foldability
@@ -209,20 +258,34 @@ impl Model {
             .constraints
             .iter()
             .map(|c| match c {
-                Constraint::Sector { vertex, k, lower, .. } => {
+                Constraint::Sector {
+                    vertex, k, lower, ..
+                } => {
                     let s = flat.sectors[*vertex][*k].clone();
-                    if *lower { s - b.alpha_min } else { S::from_f64(b.alpha_max) - s }
+                    if *lower {
+                        s - b.alpha_min
+                    } else {
+                        S::from_f64(b.alpha_max) - s
+                    }
                 }
                 Constraint::Length { crease, lower } => {
                     let c = &self.plan.creases[*crease];
                     let (p, q) = (&flat.pos[c.tail], &flat.pos[c.head]);
                     let (dx, dy) = (q[0].clone() - p[0].clone(), q[1].clone() - p[1].clone());
                     let l = (dx.clone() * dx + dy.clone() * dy).sqrt();
-                    if *lower { l - b.l_min } else { S::from_f64(b.l_max) - l }
+                    if *lower {
+                        l - b.l_min
+                    } else {
+                        S::from_f64(b.l_max) - l
+                    }
                 }
                 Constraint::Rigid { vertex, i } => {
-                    at_tmax.states[*vertex].as_ref().expect("rigid constraints are on internal vertices").margins[*i]
+                    at_tmax.states[*vertex]
+                        .as_ref()
+                        .expect("rigid constraints are on internal vertices")
+                        .margins[*i]
                         .clone()
+                        - RIGID_MARGIN
                 }
             })
             .collect()
@@ -236,7 +299,10 @@ impl Model {
             .map(|target| {
                 let folded = geometry::fold(&self.plan, &flat, modes, &target.t);
                 let x = geometry::position(&self.plan, &flat, &folded, self.gripping);
-                let d: f64 = (0..3).map(|i| (x[i] - target.point[i]).powi(2)).sum::<f64>().sqrt();
+                let d: f64 = (0..3)
+                    .map(|i| (x[i] - target.point[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
                 target.weight * d
             })
             .sum()
@@ -246,7 +312,12 @@ impl Model {
     pub fn constraint_label(&self, i: usize) -> String {
         let p = &self.plan;
         match &p.constraints[i] {
-            Constraint::Sector { vertex, k, lower, source } => {
+            Constraint::Sector {
+                vertex,
+                k,
+                lower,
+                source,
+            } => {
                 let v = &p.vertices[*vertex];
                 let n = v.rays.len();
                 let (a, b) = (v.rays[*k].other, v.rays[(*k + 1) % n].other);
@@ -272,7 +343,7 @@ impl Model {
             Constraint::Rigid { vertex, i } => {
                 let j = [(1, 2, 0), (0, 2, 1), (0, 1, 2)][*i];
                 format!(
-                    "Eq. 33: v{} rigid at t_max: U{} + U{} − U{} ≥ 0",
+                    "Eq. 33: v{} rigid at t_max: U{} + U{} − U{} ≥ 1e-8",
                     p.vertices[*vertex].name,
                     j.0 + 1,
                     j.1 + 1,

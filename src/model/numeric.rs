@@ -24,7 +24,12 @@ impl<'a> Evaluated<'a> {
     /// Evaluate `plan` at `vars` (full vector) with `modes`.
     pub fn new(plan: &'a Plan, vars: Vec<f64>, modes: Vec<f64>) -> Evaluated<'a> {
         let flat = geometry::flat(plan, &vars);
-        Evaluated { plan, vars, modes, flat }
+        Evaluated {
+            plan,
+            vars,
+            modes,
+            flat,
+        }
     }
 
     /// The folded state at `t`.
@@ -34,7 +39,9 @@ impl<'a> Evaluated<'a> {
 
     /// 3D position of every vertex at the folded state `folded`.
     pub fn coords(&self, folded: &Folded<f64>) -> Vec<[f64; 3]> {
-        (0..self.plan.vertices.len()).map(|v| geometry::position(self.plan, &self.flat, folded, v)).collect()
+        (0..self.plan.vertices.len())
+            .map(|v| geometry::position(self.plan, &self.flat, folded, v))
+            .collect()
     }
 
     /// The edges of the pattern: every crease (tail first), then the paper's edges that
@@ -44,11 +51,19 @@ impl<'a> Evaluated<'a> {
             .plan
             .creases
             .iter()
-            .map(|c| Edge { v: [c.tail, c.head], kind: EdgeKind::Crease { driven: c.drive.is_some() } })
+            .map(|c| Edge {
+                v: [c.tail, c.head],
+                kind: EdgeKind::Crease {
+                    driven: c.drive.is_some(),
+                },
+            })
             .collect();
         for (poly, closed) in &self.plan.polygons {
             if !closed && poly.len() >= 2 {
-                edges.push(Edge { v: [poly[poly.len() - 1], poly[0]], kind: EdgeKind::Boundary });
+                edges.push(Edge {
+                    v: [poly[poly.len() - 1], poly[0]],
+                    kind: EdgeKind::Boundary,
+                });
             }
         }
         edges
@@ -65,13 +80,23 @@ impl<'a> Evaluated<'a> {
                 let mut fold_angles: Vec<f64> = folded.rho.iter().map(|r| wrap_angle(*r)).collect();
                 fold_angles.resize(edges.len(), 0.0);
                 debug_assert!(fold_angles.len() >= ncreases);
-                Frame { t, coords: self.coords(&folded), fold_angles }
+                Frame {
+                    t,
+                    coords: self.coords(&folded),
+                    fold_angles,
+                }
             })
             .collect();
         Pattern {
             vertices: self.flat.pos.clone(),
             edges,
-            faces: self.plan.polygons.iter().filter(|(p, _)| p.len() >= 3).map(|(p, _)| p.clone()).collect(),
+            faces: self
+                .plan
+                .polygons
+                .iter()
+                .filter(|(p, _)| p.len() >= 3)
+                .map(|(p, _)| p.clone())
+                .collect(),
             frames,
         }
     }

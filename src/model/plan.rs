@@ -224,17 +224,32 @@ struct Builder {
 
 impl Builder {
     fn new(graph: &CreaseGraph) -> Result<Builder, PlanError> {
-        let vix = graph.vertex_ids().iter().enumerate().map(|(i, v)| (*v, i)).collect();
-        let cix = graph.creases().enumerate().map(|(i, c)| (c.cid, i)).collect();
+        let vix = graph
+            .vertex_ids()
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (*v, i))
+            .collect();
+        let cix = graph
+            .creases()
+            .enumerate()
+            .map(|(i, c)| (c.cid, i))
+            .collect();
         Ok(Builder { vix, cix })
     }
 
     fn v(&self, id: crate::grammar::Vid) -> Result<usize, PlanError> {
-        self.vix.get(&id).copied().ok_or_else(|| PlanError(format!("vertex {id:?} is not in the graph")))
+        self.vix
+            .get(&id)
+            .copied()
+            .ok_or_else(|| PlanError(format!("vertex {id:?} is not in the graph")))
     }
 
     fn c(&self, id: crate::grammar::Cid) -> Result<usize, PlanError> {
-        self.cix.get(&id).copied().ok_or_else(|| PlanError(format!("crease {id:?} is not in the graph")))
+        self.cix
+            .get(&id)
+            .copied()
+            .ok_or_else(|| PlanError(format!("crease {id:?} is not in the graph")))
     }
 
     fn build(&self, graph: &CreaseGraph) -> Result<Plan, PlanError> {
@@ -253,9 +268,9 @@ impl Builder {
                     };
                     (drive, None)
                 }
-                CreaseOrigin::Extension { length, created, .. } => {
-                    (None, Some((length.0 as usize, *created == c.head)))
-                }
+                CreaseOrigin::Extension {
+                    length, created, ..
+                } => (None, Some((length.0 as usize, *created == c.head))),
             };
             creases.push(Crease {
                 tail: self.v(c.tail)?,
@@ -295,18 +310,28 @@ impl Builder {
                     }
                 }
                 (None, Some(xy)) => Position::Fixed(xy),
-                (None, None) => return Err(PlanError(format!("vertex {:?} has no position", v.vid))),
+                (None, None) => {
+                    return Err(PlanError(format!("vertex {:?} has no position", v.vid)));
+                }
             };
             let me = self.v(v.vid)?;
             let mut rays = Vec::new();
             for &c in &v.preds {
                 let k = self.c(c)?;
-                rays.push(Ray { crease: k, other: creases[k].tail, outgoing: false });
+                rays.push(Ray {
+                    crease: k,
+                    other: creases[k].tail,
+                    outgoing: false,
+                });
             }
             if v.extended || v.ty == VertexType::Terminal {
                 for c in v.slots.iter().flatten() {
                     let k = self.c(*c)?;
-                    rays.push(Ray { crease: k, other: creases[k].head, outgoing: true });
+                    rays.push(Ray {
+                        crease: k,
+                        other: creases[k].head,
+                        outgoing: true,
+                    });
                 }
             }
             let _ = me;
@@ -331,8 +356,11 @@ impl Builder {
         let polygons = facet_polygons(&creases, facets)?;
 
         // The facet walk.
-        let internal: Vec<usize> =
-            graph.extension_order().iter().map(|v| self.v(*v)).collect::<Result<_, _>>()?;
+        let internal: Vec<usize> = graph
+            .extension_order()
+            .iter()
+            .map(|v| self.v(*v))
+            .collect::<Result<_, _>>()?;
         let mut known = vec![false; facets];
         let act = &creases[actuation.crease];
         known[act.left] = true;
@@ -353,7 +381,12 @@ impl Builder {
                 let k = (start + j) % n;
                 let f = ccw_facet(k);
                 if !known[f] {
-                    walk.push(WalkStep { facet: f, from: ccw_facet((k + n - 1) % n), vertex: a, ray: k });
+                    walk.push(WalkStep {
+                        facet: f,
+                        from: ccw_facet((k + n - 1) % n),
+                        vertex: a,
+                        ray: k,
+                    });
                     known[f] = true;
                 }
             }
@@ -375,23 +408,36 @@ impl Builder {
             }
         }
         if let Some(v) = home_facet.iter().position(|f| *f == usize::MAX) {
-            return Err(PlanError(format!("vertex v{} lies on no placed facet", v + 1)));
+            return Err(PlanError(format!(
+                "vertex v{} lies on no placed facet",
+                v + 1
+            )));
         }
 
         // Variables and constraints.
         let variables = graph
             .variables()
             .iter()
-            .map(|v| Variable { kind: v.kind, name: v.name.clone() })
+            .map(|v| Variable {
+                kind: v.kind,
+                name: v.name.clone(),
+            })
             .collect();
         let mut constraints = Vec::new();
         for spec in graph.constraints() {
             match spec {
-                ConstraintSpec::Sector { vertex, from, to, .. } => {
+                ConstraintSpec::Sector {
+                    vertex, from, to, ..
+                } => {
                     let (v, k) = self.sector_index(&vertices, vertex, from, to)?;
                     if !is_plain_variable(&vertices[v].sectors[k]) {
                         for lower in [true, false] {
-                            constraints.push(Constraint::Sector { vertex: v, k, lower, source: "Eq. 31" });
+                            constraints.push(Constraint::Sector {
+                                vertex: v,
+                                k,
+                                lower,
+                                source: "Eq. 31",
+                            });
                         }
                     }
                 }
@@ -401,13 +447,23 @@ impl Builder {
                     // above too: a sector beyond π makes a unit angle > π, outside the
                     // Euler triangles the PTU's triangle inequality is valid for (Sec. 4.4).
                     for lower in [true, false] {
-                        constraints.push(Constraint::Sector { vertex: v, k, lower, source: "Eq. 31" });
+                        constraints.push(Constraint::Sector {
+                            vertex: v,
+                            k,
+                            lower,
+                            source: "Eq. 31",
+                        });
                     }
                 }
                 ConstraintSpec::MergedSector { vertex, from, to } => {
                     let (v, k) = self.sector_index(&vertices, vertex, from, to)?;
                     for lower in [true, false] {
-                        constraints.push(Constraint::Sector { vertex: v, k, lower, source: "Eq. 34" });
+                        constraints.push(Constraint::Sector {
+                            vertex: v,
+                            k,
+                            lower,
+                            source: "Eq. 34",
+                        });
                     }
                 }
                 ConstraintSpec::Length { crease, .. } => {
@@ -436,7 +492,13 @@ impl Builder {
             vertices,
             creases,
             facets,
-            facet_names: (0..facets).map(|f| graph.facet_name(crate::grammar::FacetId(f as u32)).to_string()).collect(),
+            facet_names: (0..facets)
+                .map(|f| {
+                    graph
+                        .facet_name(crate::grammar::FacetId(f as u32))
+                        .to_string()
+                })
+                .collect(),
             polygons,
             internal,
             actuation,
@@ -474,11 +536,23 @@ fn is_plain_variable(s: &Sector) -> bool {
 
 /// The angular recipe of a ray: its angle relative to a reference ray, when known
 /// symbolically (`sign · Σ vars` from the ray to `reference`).
-fn recipe(vertices: &[Vertex], creases: &[Crease], v: usize, ray: &Ray) -> (usize, Vec<(f64, usize)>) {
+fn recipe(
+    vertices: &[Vertex],
+    creases: &[Crease],
+    v: usize,
+    ray: &Ray,
+) -> (usize, Vec<(f64, usize)>) {
     if ray.outgoing {
         let c = &creases[ray.crease];
         if let Some((_, true)) = c.length {
-            if let Position::Placed { parent, reference, sign, sectors, .. } = &vertices[c.head].position {
+            if let Position::Placed {
+                parent,
+                reference,
+                sign,
+                sectors,
+                ..
+            } = &vertices[c.head].position
+            {
                 if *parent == v {
                     return (*reference, sectors.iter().map(|s| (*sign, *s)).collect());
                 }
@@ -489,7 +563,11 @@ fn recipe(vertices: &[Vertex], creases: &[Crease], v: usize, ray: &Ray) -> (usiz
 }
 
 /// How each sector of vertex `i` is computed.
-fn sector_rules(vertices: &[Vertex], creases: &[Crease], i: usize) -> Result<Vec<Sector>, PlanError> {
+fn sector_rules(
+    vertices: &[Vertex],
+    creases: &[Crease],
+    i: usize,
+) -> Result<Vec<Sector>, PlanError> {
     let v = &vertices[i];
     let n = v.rays.len();
     let count = if v.internal {
@@ -552,7 +630,9 @@ fn facet_polygons(creases: &[Crease], facets: usize) -> Result<Vec<(Vec<usize>, 
     for c in creases {
         for (f, from, to) in [(c.left, c.tail, c.head), (c.right, c.head, c.tail)] {
             if next[f].insert(from, to).is_some() {
-                return Err(PlanError(format!("facet {f} leaves a vertex twice along its boundary")));
+                return Err(PlanError(format!(
+                    "facet {f} leaves a vertex twice along its boundary"
+                )));
             }
         }
     }
@@ -566,7 +646,11 @@ fn facet_polygons(creases: &[Crease], facets: usize) -> Result<Vec<(Vec<usize>, 
         let mut starts: Vec<usize> = map.keys().filter(|k| !heads.contains(k)).copied().collect();
         starts.sort_unstable();
         let closed = starts.is_empty();
-        let start = if closed { *map.keys().min().expect("non-empty") } else { starts[0] };
+        let start = if closed {
+            *map.keys().min().expect("non-empty")
+        } else {
+            starts[0]
+        };
         if starts.len() > 1 {
             return Err(PlanError(format!("facet {f}'s boundary is not one chain")));
         }

@@ -1,1 +1,16 @@
-//! Enumeration of design alternatives: graphs × rigid body modes × gripping candidates.
+//! The search over design alternatives (thesis Fig. 39, Sec. 5.3–5.6): every meaningful
+//! graph × every gripping candidate × every assignment of rigid body modes.
+//!
+//! Per (graph, candidate) the model is compiled once, lazily, by whichever worker needs it
+//! first; the 2^N mode assignments are parameters of that one native function. Each
+//! alternative is optimized; when it meets the target it is checked for self-intersection
+//! (both arms for a two-armed task) and against the obstacles, and verified independently
+//! (a verification failure is a bug and is reported loudly). Results stream to
+//! `OUT/alternatives.jsonl` one line per alternative as it finishes, so a killed run
+//! loses nothing and `--resume` skips what is done.
+
+mod record;
+mod run;
+
+pub use record::{AlternativeRecord, Summary, Timings, level_distribution};
+pub use run::{Alternative, SearchError, SearchOptions, prepare, run};

@@ -136,6 +136,9 @@ pub struct CheckSpec {
     pub states: usize,
     /// Cylindrical obstacles.
     pub cylinders: Vec<Cylinder>,
+    /// The design is one arm of a two-armed device: checks and pictures include a copy
+    /// rotated 180° about the z-axis (the gripper, Sec. 5.5.1).
+    pub second_arm: bool,
 }
 
 /// A cylinder obstacle: radius and the segment of its axis.
@@ -265,6 +268,8 @@ struct RawCheck {
     states: i64,
     #[serde(default)]
     cylinders: Vec<RawCylinder>,
+    #[serde(default)]
+    second_arm: bool,
 }
 
 #[derive(Deserialize)]
@@ -496,6 +501,7 @@ impl Task {
                 Some(CheckSpec {
                     states: c.states as usize,
                     cylinders,
+                    second_arm: c.second_arm,
                 })
             }
         };

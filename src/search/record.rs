@@ -1,0 +1,247 @@
+//! What the search writes: one record per alternative, and the summary.
+
+use crate::check::verify::VerifyReport;
+use crate::check::{Intersection, ObstacleHit};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// The outcome of one design alternative (one line of `alternatives.jsonl`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct AlternativeRecord {
+    /// `sequence|candidate|modes`, unique within a run.
+    pub key: String,
+    /// Index of the graph among the meaningful graphs (enumeration order).
+    pub graph: usize,
+    /// The rule sequence.
+    pub sequence: String,
+    /// Number of rule applications.
+    pub level: usize,
+    /// Number of internal vertices N.
+    pub internal_vertices: usize,
+    /// Gripping candidate 1, 2 or 3.
+    pub candidate: usize,
+    /// Name of the gripping vertex.
+    pub gripping_vertex: usize,
+    /// Rigid body mode of each internal vertex, in extension order.
+    pub modes: Vec<String>,
+    /// Ω* as the thesis defines it (Eq. 37/38).
+    pub objective: f64,
+    /// Whether ψ holds within the tolerance at the optimum.
+    pub feasible: bool,
+    /// Largest constraint violation at the optimum.
+    pub max_violation: f64,
+    /// Smallest constraint slack at the optimum.
+    pub min_slack: f64,
+    /// Feasible and Ω* ≤ ϑ (the thesis's "meets the target").
+    pub meets_target: bool,
+    /// Free of self-intersection over the checked states (when checked).
+    pub self_intersection_free: Option<bool>,
+    /// The first self-intersection found.
+    pub self_intersection: Option<Intersection>,
+    /// Why the flat layout itself is invalid (a facet inverted or overlapping itself).
+    #[serde(default)]
+    pub layout_defect: Option<String>,
+    /// Clear of every obstacle (when checked).
+    pub obstacle_free: Option<bool>,
+    /// The first obstacle hit found.
+    pub obstacle_hit: Option<ObstacleHit>,
+    /// The independent verification (when checked).
+    pub verification: Option<VerifyReport>,
+    /// Whether verification found a bug (isometry, closure, developability or fold angles
+    /// off on a rigid state).
+    pub verification_failed: Option<bool>,
+    /// Free variables at the optimum by name.
+    pub variables: BTreeMap<String, f64>,
+    /// Starting points run.
+    pub starts_run: usize,
+    /// Model evaluations spent.
+    pub evaluations: usize,
+    /// Milliseconds optimizing.
+    pub optimize_ms: f64,
+    /// Milliseconds checking and verifying.
+    pub check_ms: f64,
+}
+
+impl AlternativeRecord {
+    /// Meets the target, free of self-intersection and clear of obstacles (the thesis's
+    /// feasible concepts).
+    pub fn thesis_feasible(&self) -> bool {
+        self.meets_target
+            && self.self_intersection_free == Some(true)
+            && self.obstacle_free == Some(true)
+    }
+
+    /// Thesis-feasible and, in addition, rigid over the whole motion and verified: what
+    /// foldsynth reports as a feasible design.
+    pub fn feasible_design(&self) -> bool {
+        self.thesis_feasible()
+            && self
+                .verification
+                .as_ref()
+                .is_some_and(|v| v.rigid_over_motion)
+            && self.verification_failed == Some(false)
+    }
+
+    /// A file-name-safe identifier.
+    pub fn id(&self) -> String {
+        format!(
+            "g{:02}-c{}-{}",
+            self.graph + 1,
+            self.candidate,
+            self.modes.iter().map(|m| &m[..1]).collect::<String>()
+        )
+    }
+}
+
+/// Seconds spent per stage. Compile, optimize and check add up the time of every worker
+/// (CPU seconds); enumerate, export and total are wall time.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct Timings {
+    /// Generating and filtering the graphs.
+    pub enumerate_s: f64,
+    /// Building, simplifying, differentiating and compiling the models.
+    pub compile_s: f64,
+    /// Optimizing.
+    pub optimize_s: f64,
+    /// Intersection, obstacle and verification checks.
+    pub check_s: f64,
+    /// Writing designs, files and the report.
+    pub export_s: f64,
+    /// The whole run, wall clock.
+    pub total_s: f64,
+}
+
+/// Counts per number of rule applications (thesis Fig. 51).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct LevelCounts {
+    /// Number of rule applications.
+    pub level: usize,
+    /// Alternatives.
+    pub alternatives: usize,
+    /// Meeting the target.
+    pub meets_target: usize,
+    /// … and free of self-intersection.
+    pub no_self_intersection: usize,
+    /// … and clear of obstacles.
+    pub no_intersection: usize,
+}
+
+/// The distribution of the records over rule applications.
+pub fn level_distribution(records: &[AlternativeRecord]) -> Vec<LevelCounts> {
+    let max = records.iter().map(|r| r.level).max().unwrap_or(0);
+    (1..=max)
+        .map(|level| {
+            let at: Vec<&AlternativeRecord> = records.iter().filter(|r| r.level == level).collect();
+            LevelCounts {
+                level,
+                alternatives: at.len(),
+                meets_target: at.iter().filter(|r| r.meets_target).count(),
+                no_self_intersection: at
+                    .iter()
+                    .filter(|r| r.meets_target && r.self_intersection_free == Some(true))
+                    .count(),
+                no_intersection: at.iter().filter(|r| r.thesis_feasible()).count(),
+            }
+        })
+        .collect()
+}
+
+/// The summary of a search (`OUT/summary.json`).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Summary {
+    /// Task name.
+    pub task: String,
+    /// N_max used.
+    pub n_max: usize,
+    /// Meaningful graphs.
+    pub graphs: usize,
+    /// Alternatives evaluated (graphs × 2^N × candidates).
+    pub alternatives: usize,
+    /// Meeting the target (Ω* ≤ ϑ with ψ satisfied at t_max).
+    pub meets_target: usize,
+    /// … of those, free of self-intersection.
+    pub no_self_intersection: usize,
+    /// … of those, clear of every obstacle (the thesis's feasible concepts).
+    pub no_intersection: usize,
+    /// … of those, rigid over the whole motion and verified: foldsynth's feasible designs.
+    pub feasible: usize,
+    /// Alternatives meeting the target whose vertices are rigid at t_max (the thesis's
+    /// check) but not over the whole motion.
+    pub rigid_at_tmax_only: usize,
+    /// Verification failures (bugs), which must be 0.
+    pub verification_failures: usize,
+    /// The thesis's figures for this task, when known (alternatives, meets target, no
+    /// self-intersection, no intersection).
+    pub thesis: Option<[usize; 4]>,
+    /// Time per stage.
+    pub timings: Timings,
+    /// Distribution over rule applications (Fig. 51).
+    pub levels: Vec<LevelCounts>,
+    /// Settings of the run.
+    pub settings: serde_json::Value,
+    /// Ids of the feasible designs.
+    pub designs: Vec<String>,
+}
+
+impl Summary {
+    /// The thesis's counts for the two bundled tasks.
+    pub fn thesis_counts(task: &str) -> Option<[usize; 4]> {
+        match task {
+            "gripper" => Some([1170, 836, 148, 36]),
+            "robotic_arm" => Some([1170, 56, 29, 29]),
+            _ => None,
+        }
+    }
+
+    /// The summary as text, like the thesis's Sec. 5.6.
+    pub fn text(&self) -> String {
+        let th = |i: usize| {
+            self.thesis
+                .map(|t| format!("   (thesis: {})", t[i]))
+                .unwrap_or_default()
+        };
+        let t = &self.timings;
+        let mut s = String::new();
+        s += &format!(
+            "task {}: {} meaningful graphs (N_max = {})\n",
+            self.task, self.graphs, self.n_max
+        );
+        s += &format!(
+            "  alternatives evaluated              {:>6}{}\n",
+            self.alternatives,
+            th(0)
+        );
+        s += &format!(
+            "  meet the target                     {:>6}{}\n",
+            self.meets_target,
+            th(1)
+        );
+        s += &format!(
+            "  … free of self-intersection         {:>6}{}\n",
+            self.no_self_intersection,
+            th(2)
+        );
+        s += &format!(
+            "  … also clear of the obstacles       {:>6}{}\n",
+            self.no_intersection,
+            th(3)
+        );
+        s += &format!(
+            "  … also rigid over the whole motion  {:>6}   (foldsynth's feasible designs)\n",
+            self.feasible
+        );
+        s += &format!(
+            "  meet the target, rigid at t_max but not over the whole motion: {}\n",
+            self.rigid_at_tmax_only
+        );
+        s += &format!(
+            "  verification failures (bugs): {}\n",
+            self.verification_failures
+        );
+        s += &format!(
+            "time: enumerate {:.2} s, compile {:.2} s, optimize {:.2} s, check {:.2} s (CPU seconds over all workers), export {:.2} s; total {:.2} s wall\n",
+            t.enumerate_s, t.compile_s, t.optimize_s, t.check_s, t.export_s, t.total_s
+        );
+        s
+    }
+}

@@ -1,0 +1,829 @@
+//! Running a search: scheduling, streaming, resuming, summarizing, exporting.
+
+use super::record::{AlternativeRecord, Summary, Timings, level_distribution};
+use crate::check::verify::{Tolerances, verify};
+use crate::check::{CheckError, Cylinder, MotionSettings, check_frames, two_armed};
+use crate::compile::Options as CompileOptions;
+use crate::export::{self, DesignMeta, ExportOptions};
+use crate::grammar::{CreaseGraph, Enumeration, Filters};
+use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
+use crate::model::numeric::{Evaluated, sample_times};
+use crate::model::{Model, ModelError};
+use crate::optimize::{self, minimize};
+use crate::pattern::Pattern;
+use crate::task::Task;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use serde_json::json;
+use std::collections::{BTreeMap, HashMap};
+use std::fs::{self, File, OpenOptions};
+use std::io::{BufRead, BufReader, IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Instant;
+
+/// Settings of a search.
+#[derive(Clone, Debug)]
+pub struct SearchOptions {
+    /// Output directory.
+    pub out: PathBuf,
+    /// Worker threads (0: one per core).
+    pub jobs: usize,
+    /// Starting points per alternative.
+    pub starts: usize,
+    /// Seed of the starting points.
+    pub seed: u64,
+    /// Skip alternatives already in `OUT/alternatives.jsonl`.
+    pub resume: bool,
+    /// Override the task's N_max.
+    pub n_max: Option<usize>,
+    /// States of the verification sweep over [0, t_max].
+    pub sweep: usize,
+    /// Write FOLD/SVG/OBJ/STL/pictures/GIF for every feasible design and the report.
+    pub export: bool,
+    /// Show a progress bar on stderr (only drawn on a terminal).
+    pub progress: bool,
+}
+
+impl Default for SearchOptions {
+    fn default() -> Self {
+        SearchOptions {
+            out: PathBuf::from("out"),
+            jobs: 0,
+            starts: 24,
+            seed: 0,
+            resume: false,
+            n_max: None,
+            sweep: 181,
+            export: true,
+            progress: true,
+        }
+    }
+}
+
+/// An error of the search.
+#[derive(Debug, thiserror::Error)]
+pub enum SearchError {
+    /// The task cannot be searched.
+    #[error("task '{task}': {message}")]
+    Task {
+        /// Task name.
+        task: String,
+        /// What is missing.
+        message: String,
+    },
+    /// Reading or writing files.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// A model could not be built.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// Export failed.
+    #[error("export: {0}")]
+    Export(String),
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> SearchError + '_ {
+    move |source| SearchError::Io {
+        path: path.display().to_string(),
+        source,
+    }
+}
+
+/// One design alternative: a graph, a gripping candidate and a mode assignment.
+#[derive(Clone, Debug)]
+pub struct Alternative {
+    /// Index among the meaningful graphs.
+    pub graph: usize,
+    /// Gripping candidate 0, 1, 2.
+    pub candidate: usize,
+    /// Bit i set: internal vertex i (extension order) in mode down.
+    pub modes: u32,
+    /// Number of internal vertices.
+    pub n: usize,
+    /// The graph's rule sequence.
+    pub sequence: String,
+}
+
+impl Alternative {
+    /// ±1 per internal vertex.
+    pub fn mode_signs(&self) -> Vec<f64> {
+        (0..self.n)
+            .map(|i| if self.modes >> i & 1 == 1 { -1.0 } else { 1.0 })
+            .collect()
+    }
+    /// "up"/"down" per internal vertex.
+    pub fn mode_names(&self) -> Vec<String> {
+        self.mode_signs()
+            .iter()
+            .map(|m| if *m > 0.0 { "up".into() } else { "down".into() })
+            .collect()
+    }
+    /// The record key.
+    pub fn key(&self) -> String {
+        format!(
+            "{}|{}|{}",
+            self.sequence,
+            self.candidate + 1,
+            self.mode_names().join(",")
+        )
+    }
+}
+
+/// A compiled model ready for its 2^N alternatives.
+pub struct Prepared {
+    /// The model.
+    pub model: Model,
+    /// Its native code.
+    pub compiled: CompiledModel,
+}
+
+/// Build and compile the model of one graph and candidate.
+pub fn prepare(graph: &CreaseGraph, task: &Task, candidate: usize) -> Result<Prepared, String> {
+    let model = Model::new(graph, task, candidate).map_err(|e| e.to_string())?;
+    let compiled =
+        CompiledModel::new(&model, &CompileOptions::default()).map_err(|e| e.to_string())?;
+    Ok(Prepared { model, compiled })
+}
+
+/// A 64-bit mix (splitmix64) of the run's seed and an alternative's key: every alternative
+/// gets its own reproducible starting points, whatever the scheduling.
+fn alternative_seed(seed: u64, key: &str) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in key.bytes() {
+        h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+    }
+    let mut z = seed ^ h;
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// The obstacles of the task as the checks take them.
+fn obstacles(task: &Task) -> Vec<Cylinder> {
+    task.check
+        .as_ref()
+        .map(|c| {
+            c.cylinders
+                .iter()
+                .map(|cy| Cylinder {
+                    a: cy.from,
+                    b: cy.to,
+                    radius: cy.radius,
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// The pattern checks and exports work on: the arm, with its rotated copy for two-armed
+/// tasks.
+fn checked_pattern(task: &Task, arm: &Pattern) -> Result<Pattern, String> {
+    if task.check.as_ref().is_some_and(|c| c.second_arm) {
+        two_armed(arm).map_err(|e| e.to_string())
+    } else {
+        Ok(arm.clone())
+    }
+}
+
+/// Why an intersection check could not run.
+enum CheckFailure {
+    /// The flat layout is invalid (counts as a self-intersection).
+    Layout(String),
+    /// Anything else (reported).
+    Other(String),
+}
+
+/// Optimize, check and verify one alternative.
+fn evaluate(
+    task: &Task,
+    p: &Prepared,
+    alt: &Alternative,
+    graph: &CreaseGraph,
+    opts: &SearchOptions,
+) -> AlternativeRecord {
+    let model = &p.model;
+    let modes = alt.mode_signs();
+    let key = alt.key();
+    let t0 = Instant::now();
+    let problem = ModelProblem::new(model, &p.compiled, &modes);
+    let sol = minimize(
+        &problem,
+        &optimize::Options {
+            starts: opts.starts,
+            seed: alternative_seed(opts.seed, &key),
+            target: Some(objective_target(model)),
+            ..Default::default()
+        },
+    );
+    let optimize_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let full = model.full_vars(&sol.x);
+    let omega = model.omega(&full, &modes);
+    let meets = sol.feasible && omega <= model.threshold;
+    let variables: BTreeMap<String, f64> = model
+        .free
+        .iter()
+        .zip(&sol.x)
+        .map(|(&i, x)| (model.plan.variables[i].name.clone(), *x))
+        .collect();
+    let mut rec = AlternativeRecord {
+        key,
+        graph: alt.graph,
+        sequence: alt.sequence.clone(),
+        level: graph.level(),
+        internal_vertices: alt.n,
+        candidate: alt.candidate + 1,
+        gripping_vertex: model.plan.vertices[model.gripping].name,
+        modes: alt.mode_names(),
+        objective: omega,
+        feasible: sol.feasible,
+        max_violation: sol.violation,
+        min_slack: sol.g.iter().copied().fold(f64::INFINITY, f64::min),
+        meets_target: meets,
+        self_intersection_free: None,
+        self_intersection: None,
+        layout_defect: None,
+        obstacle_free: None,
+        obstacle_hit: None,
+        verification: None,
+        verification_failed: None,
+        variables,
+        starts_run: sol.starts_run,
+        evaluations: sol.evaluations,
+        optimize_ms,
+        check_ms: 0.0,
+    };
+    if !meets {
+        return rec;
+    }
+    let t1 = Instant::now();
+    let design = Evaluated::new(&model.plan, full, modes);
+    let states = task.check.as_ref().map(|c| c.states).unwrap_or(16);
+    let arm = design.pattern(&sample_times(model.t_max, states));
+    let checked = checked_pattern(task, &arm)
+        .map_err(CheckFailure::Other)
+        .and_then(|pat| {
+            let run = |obstacles| {
+                check_frames(
+                    &pat,
+                    &MotionSettings {
+                        n_states: states,
+                        stop_at_first: true,
+                        obstacles,
+                    },
+                )
+                .map_err(|e| match e {
+                    // A facet that cannot be triangulated is inverted or overlaps itself in the
+                    // flat layout: the paper crosses itself before it folds.
+                    CheckError::Triangulate(t) => CheckFailure::Layout(t.to_string()),
+                    e => CheckFailure::Other(e.to_string()),
+                })
+            };
+            Ok((run(Vec::new())?, run(obstacles(task))?))
+        });
+    match checked {
+        Ok((s, o)) => {
+            rec.self_intersection_free = Some(s.self_intersection_free());
+            rec.self_intersection = s.first_intersection().cloned();
+            rec.obstacle_free = Some(o.obstacle_hits.is_empty());
+            rec.obstacle_hit = o.first_obstacle_hit().cloned();
+        }
+        Err(CheckFailure::Layout(why)) => {
+            rec.self_intersection_free = Some(false);
+            rec.layout_defect = Some(why);
+        }
+        Err(CheckFailure::Other(e)) => {
+            eprintln!("warning: {}: the intersection check failed: {e}", rec.key);
+        }
+    }
+    let tol = Tolerances::default();
+    let report = verify(&design, &sample_times(model.t_max, opts.sweep), &tol);
+    let failed = !report.geometry_passes(&tol);
+    if failed {
+        eprintln!(
+            "BUG: verification failed for {} (graph {}): {}",
+            rec.key,
+            rec.sequence,
+            report.failures(&tol).join("; ")
+        );
+    }
+    rec.verification_failed = Some(failed);
+    rec.verification = Some(report);
+    rec.check_ms = t1.elapsed().as_secs_f64() * 1e3;
+    rec
+}
+
+/// Records already written by an earlier run (a torn last line from a kill is skipped).
+fn read_records(path: &Path) -> Result<Vec<AlternativeRecord>, SearchError> {
+    if !path.exists() {
+        return Ok(Vec::new());
+    }
+    let file = File::open(path).map_err(io(path))?;
+    let mut out = Vec::new();
+    for line in BufReader::new(file).lines() {
+        let line = line.map_err(io(path))?;
+        if let Ok(r) = serde_json::from_str::<AlternativeRecord>(&line) {
+            out.push(r);
+        }
+    }
+    Ok(out)
+}
+
+/// Run the search of `task` and write everything under `opts.out`.
+pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
+    let start = Instant::now();
+    let terr = |m: &str| SearchError::Task {
+        task: task.name.clone(),
+        message: m.to_string(),
+    };
+    if task.objective.is_none() {
+        return Err(terr(
+            "no [objective]: a search needs targets for the gripping vertex",
+        ));
+    }
+    if task.bounds.is_none() {
+        return Err(terr(
+            "no [bounds]: a search needs l_min, l_max, alpha_min, alpha_max",
+        ));
+    }
+    if task.motion.is_none() {
+        return Err(terr("no [motion]: a search needs t_max"));
+    }
+    let n_max = opts.n_max.unwrap_or(task.n_max);
+    if n_max == 0 {
+        return Err(terr("N_max = 0: there is nothing to extend"));
+    }
+
+    let t0 = Instant::now();
+    let enumeration = Enumeration::run(task, n_max, Filters::all());
+    let graphs: Vec<&CreaseGraph> = enumeration.meaningful().map(|n| &n.graph).collect();
+    let enumerate_s = t0.elapsed().as_secs_f64();
+
+    let mut alternatives = Vec::new();
+    for (g, graph) in graphs.iter().enumerate() {
+        let n = graph.internal_count();
+        for candidate in 0..3 {
+            for modes in 0..(1u32 << n) {
+                alternatives.push(Alternative {
+                    graph: g,
+                    candidate,
+                    modes,
+                    n,
+                    sequence: graph.sequence(),
+                });
+            }
+        }
+    }
+
+    fs::create_dir_all(&opts.out).map_err(io(&opts.out))?;
+    let jsonl = opts.out.join("alternatives.jsonl");
+    let mut done: Vec<AlternativeRecord> = if opts.resume {
+        read_records(&jsonl)?
+    } else {
+        Vec::new()
+    };
+    let wanted: HashMap<String, usize> = alternatives
+        .iter()
+        .enumerate()
+        .map(|(i, a)| (a.key(), i))
+        .collect();
+    done.retain(|r| wanted.contains_key(&r.key));
+    let finished: std::collections::HashSet<String> = done.iter().map(|r| r.key.clone()).collect();
+    let todo: Vec<&Alternative> = alternatives
+        .iter()
+        .filter(|a| !finished.contains(&a.key()))
+        .collect();
+    // Rewrite the file with the kept records, then append as alternatives finish.
+    {
+        let mut f = File::create(&jsonl).map_err(io(&jsonl))?;
+        for r in &done {
+            writeln!(
+                f,
+                "{}",
+                serde_json::to_string(r).expect("records serialize")
+            )
+            .map_err(io(&jsonl))?;
+        }
+    }
+    let writer = Mutex::new(
+        OpenOptions::new()
+            .append(true)
+            .open(&jsonl)
+            .map_err(io(&jsonl))?,
+    );
+
+    let cache: Vec<OnceLock<(Result<Arc<Prepared>, String>, f64)>> =
+        (0..graphs.len() * 3).map(|_| OnceLock::new()).collect();
+    let bar = if opts.progress && std::io::stderr().is_terminal() {
+        let b =
+            ProgressBar::with_draw_target(Some(todo.len() as u64), ProgressDrawTarget::stderr());
+        b.set_style(
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} alternatives ({eta}) {msg}",
+            )
+            .expect("valid template"),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.jobs)
+        .build()
+        .map_err(|e| terr(&e.to_string()))?;
+    let new: Vec<AlternativeRecord> = pool.install(|| {
+        todo.par_iter()
+            .filter_map(|alt| {
+                let slot = &cache[alt.graph * 3 + alt.candidate];
+                let (prepared, _) = slot.get_or_init(|| {
+                    let t = Instant::now();
+                    let p = prepare(graphs[alt.graph], task, alt.candidate).map(Arc::new);
+                    (p, t.elapsed().as_secs_f64())
+                });
+                let prepared = match prepared {
+                    Ok(p) => p.clone(),
+                    Err(e) => {
+                        eprintln!(
+                            "error: {} (candidate {}): {e}",
+                            alt.sequence,
+                            alt.candidate + 1
+                        );
+                        bar.inc(1);
+                        return None;
+                    }
+                };
+                let rec = evaluate(task, &prepared, alt, graphs[alt.graph], opts);
+                let line = serde_json::to_string(&rec).expect("records serialize");
+                if let Ok(mut w) = writer.lock() {
+                    // Each line is flushed as it is written: a kill loses at most this one.
+                    let _ = writeln!(w, "{line}").and_then(|_| w.flush());
+                }
+                bar.inc(1);
+                Some(rec)
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+
+    let mut records = done;
+    records.extend(new);
+    let order: HashMap<String, usize> = wanted;
+    records.sort_by_key(|r| order.get(&r.key).copied().unwrap_or(usize::MAX));
+
+    let compile_s: f64 = cache.iter().filter_map(|c| c.get().map(|(_, s)| *s)).sum();
+    let mut timings = Timings {
+        enumerate_s,
+        compile_s,
+        optimize_s: records.iter().map(|r| r.optimize_ms).sum::<f64>() / 1e3,
+        check_s: records.iter().map(|r| r.check_ms).sum::<f64>() / 1e3,
+        export_s: 0.0,
+        total_s: 0.0,
+    };
+    let feasible: Vec<&AlternativeRecord> =
+        records.iter().filter(|r| r.feasible_design()).collect();
+    let mut summary = Summary {
+        task: task.name.clone(),
+        n_max,
+        graphs: graphs.len(),
+        alternatives: records.len(),
+        meets_target: records.iter().filter(|r| r.meets_target).count(),
+        no_self_intersection: records
+            .iter()
+            .filter(|r| r.meets_target && r.self_intersection_free == Some(true))
+            .count(),
+        no_intersection: records.iter().filter(|r| r.thesis_feasible()).count(),
+        feasible: feasible.len(),
+        rigid_at_tmax_only: records
+            .iter()
+            .filter(|r| {
+                r.meets_target
+                    && r.verification
+                        .as_ref()
+                        .is_some_and(|v| v.rigid_at_tmax && !v.rigid_over_motion)
+            })
+            .count(),
+        verification_failures: records
+            .iter()
+            .filter(|r| r.verification_failed == Some(true))
+            .count(),
+        thesis: if n_max == 3 {
+            Summary::thesis_counts(&task.name)
+        } else {
+            None
+        },
+        timings: timings.clone(),
+        levels: level_distribution(&records),
+        settings: json!({
+            "starts": opts.starts, "seed": opts.seed, "jobs": pool.current_num_threads(),
+            "sweep": opts.sweep, "resumed": finished.len(),
+        }),
+        designs: feasible.iter().map(|r| r.id()).collect(),
+    };
+
+    let t2 = Instant::now();
+    write_designs(task, &graphs, &enumeration, &feasible, &summary, opts)?;
+    timings.export_s = t2.elapsed().as_secs_f64();
+    timings.total_s = start.elapsed().as_secs_f64();
+    summary.timings = timings;
+    let path = opts.out.join("summary.json");
+    fs::write(
+        &path,
+        serde_json::to_string_pretty(&summary).expect("summary serializes"),
+    )
+    .map_err(io(&path))?;
+    Ok(summary)
+}
+
+/// The export metadata of a design.
+fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMeta {
+    let multi = model.targets.len() > 1;
+    let mut extra = BTreeMap::new();
+    extra.insert("candidate".to_string(), json!(rec.candidate));
+    extra.insert("key".to_string(), json!(rec.key));
+    DesignMeta {
+        task: task.name.clone(),
+        rule_sequence: rec.sequence.clone(),
+        modes: rec
+            .modes
+            .iter()
+            .map(|m| {
+                if m == "up" {
+                    export::Mode::Up
+                } else {
+                    export::Mode::Down
+                }
+            })
+            .collect(),
+        gripping_vertex: Some(model.gripping),
+        objective: Some(rec.objective),
+        targets: model
+            .targets
+            .iter()
+            .map(|t| export::TargetPoint {
+                p: t.point,
+                t: Some(t.t),
+            })
+            .collect(),
+        trajectory: if multi {
+            model.targets.iter().map(|t| t.point).collect()
+        } else {
+            Vec::new()
+        },
+        obstacle: task
+            .check
+            .as_ref()
+            .and_then(|c| c.cylinders.first())
+            .map(|c| export::Cylinder {
+                a: c.from,
+                b: c.to,
+                radius: c.radius,
+            }),
+        second_arm: task.check.as_ref().is_some_and(|c| c.second_arm),
+        extra,
+    }
+}
+
+/// Write `designs/<id>.json` for every feasible design and, with export, its files and
+/// the report.
+fn write_designs(
+    task: &Task,
+    graphs: &[&CreaseGraph],
+    enumeration: &Enumeration,
+    feasible: &[&AlternativeRecord],
+    summary: &Summary,
+    opts: &SearchOptions,
+) -> Result<(), SearchError> {
+    let dir = opts.out.join("designs");
+    if dir.exists() {
+        fs::remove_dir_all(&dir).map_err(io(&dir))?;
+    }
+    fs::create_dir_all(&dir).map_err(io(&dir))?;
+    let mut cards = Vec::new();
+    for rec in feasible {
+        let p = prepare(graphs[rec.graph], task, rec.candidate - 1).map_err(SearchError::Export)?;
+        let model = &p.model;
+        let free: Vec<f64> = model
+            .free
+            .iter()
+            .map(|&i| {
+                rec.variables
+                    .get(&model.plan.variables[i].name)
+                    .copied()
+                    .unwrap_or(model.var_bounds(i).0)
+            })
+            .collect();
+        let full = model.full_vars(&free);
+        let modes: Vec<f64> = rec
+            .modes
+            .iter()
+            .map(|m| if m == "up" { 1.0 } else { -1.0 })
+            .collect();
+        let design = Evaluated::new(&model.plan, full.clone(), modes);
+        let pattern = design.pattern(&sample_times(model.t_max, 33));
+        let meta = design_meta(task, model, rec);
+        let all_vars: BTreeMap<String, f64> = model
+            .plan
+            .variables
+            .iter()
+            .zip(&full)
+            .map(|(v, x)| (v.name.clone(), *x))
+            .collect();
+        let constraints: Vec<_> = {
+            let (_, g) = crate::model::compiled::outputs_f64(model, &free, &design.modes);
+            g.iter()
+                .enumerate()
+                .map(|(k, v)| json!({"label": model.constraint_label(k), "value": v}))
+                .collect()
+        };
+        let id = rec.id();
+        let doc = json!({
+            "id": id,
+            "task": task.name,
+            "sequence": rec.sequence,
+            "level": rec.level,
+            "candidate": rec.candidate,
+            "gripping_vertex": rec.gripping_vertex,
+            "modes": rec.modes,
+            "objective": rec.objective,
+            "threshold": model.threshold,
+            "variables": rec.variables,
+            "all_variables": all_vars,
+            "constraint_slack": rec.min_slack,
+            "constraints": constraints,
+            "verification": rec.verification,
+            "self_intersection_free": rec.self_intersection_free,
+            "obstacle_free": rec.obstacle_free,
+            "pattern": pattern,
+            "meta": meta,
+        });
+        let path = dir.join(format!("{id}.json"));
+        fs::write(
+            &path,
+            serde_json::to_string_pretty(&doc).expect("design serializes"),
+        )
+        .map_err(io(&path))?;
+        if opts.export {
+            let out = dir.join(&id);
+            let eo = ExportOptions {
+                name: id.clone(),
+                ..Default::default()
+            };
+            let files = export::write_all(&out, &pattern, &meta, &eo)
+                .map_err(|e| SearchError::Export(e.to_string()))?;
+            let check = export::verify::verify_file(&files.fold, &Default::default())
+                .map_err(|e| SearchError::Export(e.to_string()))?;
+            if !check.ok {
+                eprintln!("BUG: the exported FOLD file of {id} fails verification");
+            }
+            cards.push(export::report::ReportDesign {
+                title: format!(
+                    "{} — candidate {} — {}",
+                    rec.sequence,
+                    rec.candidate,
+                    rec.modes.join(", ")
+                ),
+                meta,
+                files,
+                verify: Some(check),
+            });
+        }
+    }
+    if opts.export {
+        let input = report_input(task, enumeration, summary, cards);
+        export::report::write_report(&opts.out, &input)
+            .map_err(|e| SearchError::Export(e.to_string()))?;
+    }
+    Ok(())
+}
+
+/// The report's content.
+fn report_input(
+    task: &Task,
+    enumeration: &Enumeration,
+    s: &Summary,
+    designs: Vec<export::report::ReportDesign>,
+) -> export::report::ReportInput {
+    use export::plots::{DistributionPlot, NodeStatus, Series, TreeNode};
+    use export::report::{CountRow, ReportInput, ReportSummary, TimingRow};
+    let th = |i: usize| s.thesis.map(|t| t[i] as u64);
+    let counts = vec![
+        CountRow {
+            label: "meaningful graphs".into(),
+            value: s.graphs as u64,
+            thesis: s.thesis.map(|_| 52),
+        },
+        CountRow {
+            label: "alternatives evaluated".into(),
+            value: s.alternatives as u64,
+            thesis: th(0),
+        },
+        CountRow {
+            label: "meet the target".into(),
+            value: s.meets_target as u64,
+            thesis: th(1),
+        },
+        CountRow {
+            label: "… free of self-intersection".into(),
+            value: s.no_self_intersection as u64,
+            thesis: th(2),
+        },
+        CountRow {
+            label: "… also clear of the obstacles".into(),
+            value: s.no_intersection as u64,
+            thesis: th(3),
+        },
+        CountRow {
+            label: "… also rigid over the whole motion".into(),
+            value: s.feasible as u64,
+            thesis: None,
+        },
+        CountRow {
+            label: "rigid at t_max only (thesis check passes, full motion fails)".into(),
+            value: s.rigid_at_tmax_only as u64,
+            thesis: None,
+        },
+        CountRow {
+            label: "verification failures".into(),
+            value: s.verification_failures as u64,
+            thesis: None,
+        },
+    ];
+    let t = &s.timings;
+    let timings = vec![
+        TimingRow {
+            stage: "enumerate (wall)".into(),
+            seconds: t.enumerate_s,
+        },
+        TimingRow {
+            stage: "compile (CPU)".into(),
+            seconds: t.compile_s,
+        },
+        TimingRow {
+            stage: "optimize (CPU)".into(),
+            seconds: t.optimize_s,
+        },
+        TimingRow {
+            stage: "check + verify (CPU)".into(),
+            seconds: t.check_s,
+        },
+    ];
+    let tree = enumeration
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(i, n)| TreeNode {
+            id: i,
+            parent: n.parent,
+            label: n.graph.sequence(),
+            level: n.level,
+            status: match n.status {
+                crate::grammar::Status::Meaningful => NodeStatus::Meaningful,
+                crate::grammar::Status::Invalid => NodeStatus::Invalid,
+                crate::grammar::Status::Mirror => NodeStatus::Mirror,
+                crate::grammar::Status::Isomorphic => NodeStatus::Isomorphic,
+            },
+        })
+        .collect();
+    let series = |name: &str, f: &dyn Fn(&super::record::LevelCounts) -> usize| Series {
+        name: name.into(),
+        points: s
+            .levels
+            .iter()
+            .map(|l| [l.level as f64, f(l) as f64])
+            .collect(),
+    };
+    let distribution = DistributionPlot {
+        title: format!(
+            "{}: designs over rule applications (thesis Fig. 51)",
+            task.name
+        ),
+        x_label: "rule applications".into(),
+        y_label: "designs".into(),
+        series: vec![
+            series("all", &|l| l.alternatives),
+            series("meet the target", &|l| l.meets_target),
+            series("no self-intersection", &|l| l.no_self_intersection),
+            series("no intersection", &|l| l.no_intersection),
+        ],
+    };
+    ReportInput {
+        summary: ReportSummary {
+            title: format!("foldsynth — {}", task.name),
+            task: task.name.clone(),
+            counts,
+            timings,
+            notes: vec![format!(
+                "{} starting points per alternative, seed {}; total {:.1} s wall.",
+                s.settings["starts"], s.settings["seed"], t.total_s
+            )],
+        },
+        tree,
+        distribution: Some(distribution),
+        designs,
+    }
+}
