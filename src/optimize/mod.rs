@@ -77,6 +77,9 @@ pub struct Options {
     pub feasibility_tol: f64,
     /// Stop as soon as a feasible point has `f ≤ target`.
     pub target: Option<f64>,
+    /// A start has converged when it is feasible and an outer iteration changes the
+    /// objective by less than this, relative to `1 + |f|`.
+    pub rel_tol: f64,
 }
 
 impl Default for Options {
@@ -84,10 +87,11 @@ impl Default for Options {
         Options {
             starts: 16,
             seed: 0,
-            max_outer: 12,
-            max_inner: 200,
+            max_outer: 10,
+            max_inner: 150,
             feasibility_tol: 1e-9,
             target: None,
+            rel_tol: 1e-10,
         }
     }
 }
@@ -250,10 +254,13 @@ impl<P: Problem> Gradient for Merit<'_, P> {
 }
 
 /// Minimize the merit from `y0` with L-BFGS; returns the best point (or `y0`).
-fn lbfgs<P: Problem>(merit: Merit<'_, P>, y0: Vec<f64>, max_iters: u64) -> Vec<f64> {
+/// argmin's cost tolerance is absolute; `scale` (the merit at the start) makes it
+/// relative, so subproblems stop when they stall instead of running to the cap.
+fn lbfgs<P: Problem>(merit: Merit<'_, P>, y0: Vec<f64>, max_iters: u64, rel_tol: f64) -> Vec<f64> {
+    let scale = merit.compute(&y0).0.abs().clamp(1e-12, 1e12);
     let solver = LBFGS::new(MoreThuenteLineSearch::new(), 8)
-        .with_tolerance_grad(1e-12)
-        .and_then(|s| s.with_tolerance_cost(1e-16));
+        .with_tolerance_grad(1e-10)
+        .and_then(|s| s.with_tolerance_cost(rel_tol * 1e-3 * scale));
     let Ok(solver) = solver else { return y0 };
     match Executor::new(merit, solver)
         .configure(|s| s.param(y0.clone()).max_iters(max_iters))
@@ -289,6 +296,7 @@ pub fn minimize<P: Problem>(problem: &P, opts: &Options) -> Solution {
         let mut lambda = vec![0.0; m];
         let mut mu = 10.0;
         let mut prev_violation = f64::INFINITY;
+        let mut prev_f = f64::INFINITY;
         for _ in 0..opts.max_outer {
             let merit = Merit {
                 problem,
@@ -299,7 +307,7 @@ pub fn minimize<P: Problem>(problem: &P, opts: &Options) -> Solution {
                 work: RefCell::new(Evaluation::new(n, m)),
                 evaluations: &counter,
             };
-            y = lbfgs(merit, y.clone(), opts.max_inner);
+            y = lbfgs(merit, y.clone(), opts.max_inner, opts.rel_tol);
             problem.eval(&transform.x(&y), &mut eval);
             evaluations += 1;
             let violation = eval.violation();
@@ -310,16 +318,15 @@ pub fn minimize<P: Problem>(problem: &P, opts: &Options) -> Solution {
                 if opts.target.is_some_and(|t| eval.f <= t) {
                     break;
                 }
-                if violation == 0.0
-                    && lambda.iter().all(|l| *l == 0.0)
-                    && prev_violation <= opts.feasibility_tol
-                {
+                // Converged: feasible, and the last outer step no longer moves f.
+                if (eval.f - prev_f).abs() <= opts.rel_tol * (1.0 + eval.f.abs()) {
                     break;
                 }
             } else if violation > 0.25 * prev_violation {
                 mu = (mu * 10.0).min(1e9);
             }
             prev_violation = violation;
+            prev_f = eval.f;
         }
         let x = transform.x(&y);
         problem.eval(&x, &mut eval);
