@@ -78,6 +78,28 @@ impl Drive {
         }
     }
 
+    /// A trajectory that turns `vertex`, starting at `initial`, about the axis through
+    /// `origin` along `axis` by `angle(t)` (right-handed). The thesis's G0 drive is two of
+    /// these per facet vertex: f1's vertices by +t/2 and f2's by −t/2 about the x-axis.
+    pub fn rotation_about_axis(
+        vertex: usize,
+        initial: [f64; 3],
+        origin: [f64; 3],
+        axis: [f64; 3],
+        angle: AngleFn,
+    ) -> Drive {
+        let o = Vector3::from(origin);
+        let axis = Unit::new_normalize(Vector3::from(axis));
+        let p = Vector3::from(initial) - o;
+        Drive::Trajectory {
+            vertex,
+            path: Arc::new(move |t| {
+                let x = o + Rotation3::from_axis_angle(&axis, angle(t)) * p;
+                [x.x, x.y, x.z]
+            }),
+        }
+    }
+
     /// A crease drive from a formula for the angle.
     pub fn crease_from_formula(
         p: usize,
@@ -304,6 +326,30 @@ fn traverses(f: &[usize], p: usize, q: usize) -> bool {
 }
 
 impl SimInput {
+    /// An input for a [`crate::pattern::Pattern`]: its flat layout (z = 0) as the initial
+    /// state, its facets, `t` over the range of its frames and one step per frame after the
+    /// first (J = frames − 1, at least 1). Drives and supports are left empty for the caller
+    /// (e.g. trajectories that follow the model's driven facets).
+    pub fn from_pattern(pattern: &crate::pattern::Pattern) -> SimInput {
+        let (t_start, t_end) = match (pattern.frames.first(), pattern.frames.last()) {
+            (Some(a), Some(b)) => (a.t, b.t),
+            _ => (0.0, 0.0),
+        };
+        SimInput {
+            initial: pattern.flat_coords(),
+            faces: pattern.faces.clone(),
+            extra_bars: Vec::new(),
+            fixed: Vec::new(),
+            drives: Vec::new(),
+            t_start,
+            t_end,
+            steps: pattern.frames.len().saturating_sub(1).max(1),
+            first_step_offsets: Vec::new(),
+            check_intersections: true,
+            solver: SolverSettings::default(),
+        }
+    }
+
     /// Check the input and resolve the supports.
     pub(crate) fn resolve(&self) -> Result<Supports, InputError> {
         let n = self.initial.len();
