@@ -134,3 +134,30 @@ fn annealing_is_seeded_bounded_and_keeps_the_best() {
     let other = anneal(&task, &AnnealSettings { seed: 6, ..s }).unwrap();
     assert_ne!(other.trace, a.trace);
 }
+
+/// Started from a feasible design (the thesis's, within its printed rounding), the
+/// annealing's best feasible design exists, is feasible, is at least as good as the start,
+/// and no better than the overall best; re-evaluating it gives the same result.
+#[test]
+fn best_feasible_is_feasible_and_least_among_feasible() {
+    let task = FlasherTask::shipped().unwrap();
+    let nearby = [
+        [1.495, 1.395, -0.105],
+        [0.525, 5.275, 0.025],
+        THESIS_BEST[2],
+    ];
+    let start = task.variables(&nearby);
+    let s = AnnealSettings {
+        evaluations: 30,
+        seed: 1,
+        start: Some(start),
+        ..AnnealSettings::default()
+    };
+    let a = anneal(&task, &s).unwrap();
+    assert!(a.start.feasible);
+    let f = a.best_feasible.as_ref().expect("the start is feasible");
+    assert!(f.feasible && f.theta == 0.0 && f.rigid);
+    assert!(f.objective <= a.start.objective);
+    assert!(f.objective >= a.best.objective);
+    assert_eq!(&task.evaluate(&f.variables), f);
+}

@@ -23,6 +23,9 @@ pub struct OptimizeFlasherArgs {
     /// A flasher pattern file to use instead of the shipped grammar/flasher_adapted.toml.
     #[arg(long)]
     pub pattern: Option<PathBuf>,
+    /// Start from the pattern file's v3, v4, v5 instead of a random point.
+    #[arg(long)]
+    pub start_from_file: bool,
     /// Print the result as JSON.
     #[arg(long)]
     pub json: bool,
@@ -37,6 +40,7 @@ pub fn run(args: OptimizeFlasherArgs) -> anyhow::Result<()> {
     let settings = AnnealSettings {
         evaluations: args.evals as usize,
         seed: args.seed,
+        start: args.start_from_file.then(|| task.file_variables()),
         ..AnnealSettings::default()
     };
     let t0 = std::time::Instant::now();
@@ -48,6 +52,7 @@ pub fn run(args: OptimizeFlasherArgs) -> anyhow::Result<()> {
         let out = serde_json::json!({
             "settings": settings,
             "best": result.best,
+            "best_feasible": result.best_feasible,
             "start": result.start,
             "evaluations": result.evaluations,
             "seconds": seconds,
@@ -135,6 +140,20 @@ pub fn run(args: OptimizeFlasherArgs) -> anyhow::Result<()> {
         String::new(),
     );
     design(&mut o, "best design", e);
+    match &result.best_feasible {
+        Some(f) if f != e => {
+            let _ = writeln!(
+                o,
+                "best feasible design: objective {:.4}, A = {:.3}, Gamma = {:.2e}, theta = 0, Omega = {:.1e}",
+                f.objective, f.area, f.gamma, f.omega
+            );
+            design(&mut o, "best feasible design", f);
+        }
+        Some(_) => {}
+        None => {
+            let _ = writeln!(o, "no feasible design among the evaluations");
+        }
+    }
     super::simulate::emit(&o)
 }
 

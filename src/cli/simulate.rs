@@ -30,8 +30,19 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         file.input.steps = j as usize;
     }
     let start = std::time::Instant::now();
-    let report =
-        simulate(&file.input).with_context(|| format!("simulating {}", args.file.display()))?;
+    let report = simulate(&file.input).with_context(|| {
+        let legend: Vec<String> = file
+            .vertex_names
+            .iter()
+            .enumerate()
+            .map(|(i, n)| format!("{i}={n}"))
+            .collect();
+        format!(
+            "simulating {} (vertex numbers: {})",
+            args.file.display(),
+            legend.join(", ")
+        )
+    })?;
     let seconds = start.elapsed().as_secs_f64();
     if args.json {
         let out = serde_json::json!({

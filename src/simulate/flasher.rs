@@ -28,7 +28,7 @@
 //!   of every outer loop. A move adds to every variable a uniform step of at most one tenth
 //!   of its range (the thesis's neighbourhood), clamped to the bounds. argmin accepts a worse
 //!   point with probability 1/(1 + exp(Δ/T)). The start point is drawn uniformly within the
-//!   bounds. Everything is seeded: the same seed gives the same run.
+//!   bounds (or given). Everything is seeded: the same seed gives the same run.
 
 use std::cell::RefCell;
 use std::f64::consts::PI;
@@ -174,6 +174,16 @@ impl FlasherTask {
         ]
     }
 
+    /// Eq. 5's variables of the pattern file's own v3, v4, v5.
+    pub fn file_variables(&self) -> [f64; 9] {
+        let at = |n: &str| {
+            self.file
+                .vertex(n)
+                .map_or([0.0; 3], |i| self.file.input.initial[i])
+        };
+        self.variables(&[at("v3"), at("v4"), at("v5")])
+    }
+
     /// Eq. 5's variables for starting positions of v3, v4, v5 (the inverse of
     /// [`FlasherTask::positions`]; not clamped to the bounds).
     pub fn variables(&self, x: &[[f64; 3]; 3]) -> [f64; 9] {
@@ -288,6 +298,9 @@ pub struct AnnealSettings {
     pub factor: f64,
     /// Evaluations per outer loop (temperature level).
     pub inner: usize,
+    /// Start point (Eq. 5 variables, clamped to the bounds); `None` draws one uniformly
+    /// within the bounds from the seed.
+    pub start: Option<[f64; 9]>,
 }
 
 impl Default for AnnealSettings {
@@ -299,6 +312,7 @@ impl Default for AnnealSettings {
             start_temperature: 200.0,
             factor: 0.89,
             inner: 50,
+            start: None,
         }
     }
 }
@@ -308,6 +322,10 @@ impl Default for AnnealSettings {
 pub struct AnnealResult {
     /// The best design found (re-evaluated once after the run).
     pub best: FlasherEvaluation,
+    /// The best feasible design among all evaluations (the objective's weights let an
+    /// intersecting design with a larger area beat every feasible one, so the overall best
+    /// need not be feasible).
+    pub best_feasible: Option<FlasherEvaluation>,
     /// The start point's evaluation.
     pub start: FlasherEvaluation,
     /// Objective evaluations the annealing made.
@@ -320,6 +338,7 @@ struct Annealer {
     task: FlasherTask,
     rng: RefCell<ChaCha8Rng>,
     trace: Rc<RefCell<Vec<f64>>>,
+    best_feasible: Rc<RefCell<Option<FlasherEvaluation>>>,
 }
 
 fn to_array(p: &[f64]) -> [f64; 9] {
@@ -335,8 +354,15 @@ impl CostFunction for Annealer {
     type Output = f64;
 
     fn cost(&self, p: &Self::Param) -> Result<f64, ArgminError> {
-        let c = self.task.evaluate(&to_array(p)).objective;
+        let e = self.task.evaluate(&to_array(p));
+        let c = e.objective;
         self.trace.borrow_mut().push(c);
+        if e.feasible {
+            let mut best = self.best_feasible.borrow_mut();
+            if best.as_ref().is_none_or(|b| c < b.objective) {
+                *best = Some(e);
+            }
+        }
         Ok(c)
     }
 }
@@ -361,15 +387,25 @@ impl Anneal for Annealer {
 /// Run the simulated annealing of Sec. 3.6 on the task.
 pub fn anneal(task: &FlasherTask, s: &AnnealSettings) -> Result<AnnealResult, ArgminError> {
     let mut rng = ChaCha8Rng::seed_from_u64(s.seed);
-    let start: Vec<f64> = BOUNDS
+    let drawn: Vec<f64> = BOUNDS
         .iter()
         .map(|&(lo, hi)| rng.random_range(lo..=hi))
         .collect();
+    let start: Vec<f64> = match s.start {
+        Some(v) => v
+            .iter()
+            .zip(BOUNDS)
+            .map(|(&x, (lo, hi))| x.clamp(lo, hi))
+            .collect(),
+        None => drawn,
+    };
     let trace = Rc::new(RefCell::new(Vec::with_capacity(s.evaluations)));
+    let best_feasible = Rc::new(RefCell::new(None));
     let problem = Annealer {
         task: task.clone(),
         rng: RefCell::new(rng),
         trace: trace.clone(),
+        best_feasible: best_feasible.clone(),
     };
     let accept_rng = {
         use rand_xoshiro::rand_core::SeedableRng as _;
@@ -389,8 +425,10 @@ pub fn anneal(task: &FlasherTask, s: &AnnealSettings) -> Result<AnnealResult, Ar
         .cloned()
         .unwrap_or_else(|| start.clone());
     let trace = trace.borrow().clone();
+    let best_feasible = best_feasible.borrow().clone();
     Ok(AnnealResult {
         best: task.evaluate(&to_array(&best_param)),
+        best_feasible,
         start: task.evaluate(&to_array(&start)),
         evaluations: trace.len(),
         trace,

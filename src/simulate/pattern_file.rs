@@ -202,6 +202,12 @@ impl PatternFile {
         if spec.vertices.is_empty() {
             return Err(err("vertices", "at least one vertex is needed".into()));
         }
+        if spec.faces.is_empty() && spec.faces_once.is_empty() {
+            return Err(err(
+                "faces",
+                "at least one facet is needed (bars come from facets)".into(),
+            ));
+        }
         // Vertices, replicated.
         let mut names: Vec<String> = Vec::new();
         let mut initial: Vec<[f64; 3]> = Vec::new();
