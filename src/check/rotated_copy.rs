@@ -98,7 +98,7 @@ pub fn with_rotated_copy(
             let o = fr.coords[j];
             let gap =
                 ((q[0] - o[0]).powi(2) + (q[1] - o[1]).powi(2) + (q[2] - o[2]).powi(2)).sqrt();
-            if !(gap <= tol) {
+            if gap.is_nan() || gap > tol {
                 return Err(RotatedCopyError::SharedVertexMoves {
                     vertex: j,
                     t: fr.t,

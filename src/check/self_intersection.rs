@@ -389,7 +389,7 @@ impl<'a> StateTracker<'a> {
         };
         let limit = std::f64::consts::PI + 1e-9;
         for (h, &rho) in self.checker.hinges.iter().zip(&next) {
-            if rho.abs() > limit && !(first_only && !out.is_empty()) {
+            if rho.abs() > limit && (out.is_empty() || !first_only) {
                 out.push(Intersection {
                     face_a: h.face_a,
                     face_b: h.face_b,

@@ -10,6 +10,8 @@ pub mod model;
 pub mod synthesize;
 pub mod verify;
 pub mod vertex;
+pub mod optimize_flasher;
+pub mod simulate;
 
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
 #[derive(Debug, Parser)]
@@ -39,6 +41,10 @@ pub enum Command {
     Export(export::ExportArgs),
     /// Check a FOLD file: isometry of every folded frame, fold angles, face consistency.
     Verify(verify::VerifyArgs),
+    /// Simulate a pattern file with the bar-and-hinge model (thesis Sec. 3).
+    Simulate(simulate::SimulateArgs),
+    /// Optimize the adapted flasher by simulated annealing (thesis Sec. 3.6-3.7).
+    OptimizeFlasher(optimize_flasher::OptimizeFlasherArgs),
 }
 
 /// Run one parsed command line.
@@ -52,5 +58,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Model(a) => model::run(a),
         Command::Export(a) => export::run(a),
         Command::Verify(a) => verify::run(a),
+        Command::Simulate(a) => simulate::run(a),
+        Command::OptimizeFlasher(a) => optimize_flasher::run(a),
     }
 }
