@@ -342,6 +342,8 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
             "ops_gradient": ops_gradient,
             "calls_before": rep.input.calls,
             "calls_after": rep.simplified.calls,
+            "native_calls_value": value_only.function.n_calls(),
+            "native_calls_value_grad": compiled.function.n_calls(),
             "simplify": rep.simplify,
             "max_rel_dev_value": max_dev_value,
             "max_rel_dev_grad_vs_dual": max_dev_dual,
@@ -372,8 +374,11 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     );
     println!("value φ1+φ2+φ3 = {:.15} at t = {t}", buf[0]);
     println!(
-        "operations: built {ops_before}, simplified {ops_after} ({shrink:+.1}% shrink), with gradient {ops_gradient}; calls {} -> {}",
-        rep.input.calls, rep.simplified.calls
+        "operations: built {ops_before}, simplified {ops_after} ({shrink:.1}% fewer), with gradient {ops_gradient}; transcendental nodes {} -> {}; libm calls in the native code: value {}, value+gradient {} (sin+cos of one argument = one sincos)",
+        rep.input.calls,
+        rep.simplified.calls,
+        value_only.function.n_calls(),
+        compiled.function.n_calls()
     );
     println!();
     println!(

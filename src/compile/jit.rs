@@ -76,6 +76,7 @@ pub struct CompiledFn {
     n_params: usize,
     n_outputs: usize,
     n_instructions: usize,
+    n_calls: usize,
 }
 
 // SAFETY: after `finalize_definitions` the module is never mutated again; the only thing
@@ -92,6 +93,7 @@ impl std::fmt::Debug for CompiledFn {
             .field("n_params", &self.n_params)
             .field("n_outputs", &self.n_outputs)
             .field("n_instructions", &self.n_instructions)
+            .field("n_calls", &self.n_calls)
             .finish()
     }
 }
@@ -147,7 +149,7 @@ impl CompiledFn {
         let mut module = JITModule::new(jb);
         let result = build(&mut module, graph, outputs, &mark);
         match result {
-            Ok((func_id, n_instructions)) => {
+            Ok((func_id, n_instructions, n_calls)) => {
                 if let Err(e) = module.finalize_definitions() {
                     // SAFETY: nothing points into the module yet.
                     unsafe { module.free_memory() };
@@ -164,6 +166,7 @@ impl CompiledFn {
                     n_params,
                     n_outputs: outputs.len(),
                     n_instructions,
+                    n_calls,
                 })
             }
             Err(e) => {
@@ -189,6 +192,11 @@ impl CompiledFn {
     /// Number of IR instructions emitted (before Cranelift's own optimizations).
     pub fn n_instructions(&self) -> usize {
         self.n_instructions
+    }
+    /// Number of calls to libm in the generated code (a `sin` and a `cos` of one
+    /// argument are one `sincos` call).
+    pub fn n_calls(&self) -> usize {
+        self.n_calls
     }
 
     /// Evaluate into `out` after checking every length.
@@ -239,7 +247,7 @@ fn build(
     graph: &ExprGraph,
     outputs: &[NodeId],
     mark: &[bool],
-) -> Result<(FuncId, usize), CompileError> {
+) -> Result<(FuncId, usize, usize), CompileError> {
     let ptr = module.target_config().pointer_type();
     let mut sig = module.make_signature();
     for _ in 0..3 {
@@ -291,6 +299,7 @@ fn build(
     let mut fctx = FunctionBuilderContext::new();
     let target = module.target_config();
     let mut n_inst = 0usize;
+    let mut n_calls = 0usize;
     {
         let mut b = FunctionBuilder::new(&mut ctx.func, &mut fctx);
         let block = b.create_block();
@@ -341,6 +350,7 @@ fn build(
                             let c_ptr = b.ins().iadd_imm_s(addr, 8);
                             let arg = v(a);
                             b.ins().call(f, &[arg, s_ptr, c_ptr]);
+                            n_calls += 1;
                             let sv = b.ins().load(types::F64, mem, addr, 0);
                             let cv = b.ins().load(types::F64, mem, addr, 8);
                             sincos_done.insert(a, (sv, cv));
@@ -358,12 +368,14 @@ fn build(
                     let f = import(slot, id, &mut b);
                     let arg = v(a);
                     let call = b.ins().call(f, &[arg]);
+                    n_calls += 1;
                     b.inst_results(call)[0]
                 }
                 Node::Atan2(y, xx) => {
                     let f = import(&mut imports.atan2, ids[3], &mut b);
                     let (ya, xa) = (v(y), v(xx));
                     let call = b.ins().call(f, &[ya, xa]);
+                    n_calls += 1;
                     b.inst_results(call)[0]
                 }
                 Node::Sgn(a) => {
@@ -405,7 +417,7 @@ fn build(
     }
     module.define_function(func_id, &mut ctx).map_err(cg)?;
     module.clear_context(&mut ctx);
-    Ok((func_id, n_inst))
+    Ok((func_id, n_inst, n_calls))
 }
 
 #[cfg(test)]
