@@ -1,84 +1,38 @@
-//! Criterion benchmarks of the symbolic compiler on the degree-7 vertex with symbolic
-//! sectors (the reference case): JIT value, JIT value+gradient, the interpreter,
-//! f64 + central differences, dual numbers, and the compile pipeline.
-//! `foldsynth bench vertex` reports the same figures as ratios from one run.
+//! One PTU vertex evaluation (all of U, θ, β, δ, φ and the margins) in f64, for degree
+//! 4, 8 and 360 — the thesis calls this "real time".
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use foldsynth::compile::vertex::{self, VertexModel};
-use foldsynth::compile::{Dual, Options, compile};
-use foldsynth::expr::Tape;
-use foldsynth::kinematics::VertexSpec;
+use foldsynth::kinematics::{Unit, VertexSpec, solve_vertex};
 use std::hint::black_box;
 
-const V7: &str = "v(up, ((40,50,45,35,40),(t,-t,t,-t)), (55), (95))";
+fn symmetric(n: usize, t: f64) -> [Unit<f64>; 3] {
+    let m = n / 3;
+    let rho: Vec<f64> = (0..m - 1)
+        .map(|i| if i % 2 == 0 { t } else { -t })
+        .collect();
+    let u = Unit::new(vec![2.0 * std::f64::consts::PI / n as f64; m], rho);
+    [u.clone(), u.clone(), u]
+}
 
 fn bench(c: &mut Criterion) {
-    let spec = VertexSpec::parse(V7).expect("valid vertex");
-    let t = vertex::most_rigid_t(&spec);
-    let (x, p) = vertex::point(&spec, true, t);
-    let n = x.len();
-    let model = VertexModel::build(&spec, true);
-    let g = model.ctx.to_graph();
-    let out = [model.phi_sum_id()];
-    let (nv, np) = (model.n_vars, model.n_params);
-    let vg = compile(&g, &out, nv, np, &Options::default()).expect("compiles");
-    let v = compile(
-        &g,
-        &out,
-        nv,
-        np,
-        &Options {
-            gradients: false,
-            ..Options::default()
-        },
-    )
-    .expect("compiles");
-    let tape = Tape::new(&vg.graph, &vg.outputs, nv, np).expect("tape");
-
-    let mut buf = vec![0.0; vg.layout.len()];
-    c.bench_function("v7/jit_value", |b| {
-        let mut o = [0.0];
-        b.iter(|| v.function.call(black_box(&x), black_box(&p), &mut o))
+    let d4 = VertexSpec::parse("v(up, ((100,80),(t)), (95), (85))")
+        .unwrap()
+        .units_at(1.0);
+    let d8 = VertexSpec::parse("v(up, ((40,50,45,35),(t,-t,t)), ((55,45),(-t)), ((40,50),(t)))")
+        .unwrap()
+        .units_at(1.0);
+    let d360 = symmetric(360, 1.2);
+    let mut g = c.benchmark_group("ptu_vertex");
+    g.bench_function("degree4", |b| {
+        b.iter(|| solve_vertex(black_box(&d4), black_box(&1.0)))
     });
-    c.bench_function("v7/jit_value_grad", |b| {
-        b.iter(|| vg.function.call(black_box(&x), black_box(&p), &mut buf))
+    g.bench_function("degree8", |b| {
+        b.iter(|| solve_vertex(black_box(&d8), black_box(&1.0)))
     });
-    c.bench_function("v7/interpreter_value_grad", |b| {
-        let mut scratch = Vec::new();
-        let mut o = vec![0.0; vg.layout.len()];
-        b.iter(|| tape.eval_with(&mut scratch, black_box(&x), black_box(&p), &mut o))
+    g.bench_function("degree360", |b| {
+        b.iter(|| solve_vertex(black_box(&d360), black_box(&1.0)))
     });
-    c.bench_function("v7/f64_central_diff", |b| {
-        b.iter(|| {
-            let mut g = vec![0.0; n];
-            let mut y = x.clone();
-            let f0 = vertex::phi_sum(&spec, true, &y, &p);
-            for i in 0..n {
-                let xi = y[i];
-                y[i] = xi + 1e-6;
-                let fp = vertex::phi_sum(&spec, true, &y, &p);
-                y[i] = xi - 1e-6;
-                let fm = vertex::phi_sum(&spec, true, &y, &p);
-                y[i] = xi;
-                g[i] = (fp - fm) / 2e-6;
-            }
-            black_box((f0, g))
-        })
-    });
-    c.bench_function("v7/dual", |b| {
-        let dp: Vec<Dual> = p.iter().map(|&q| Dual::constant(q)).collect();
-        b.iter(|| {
-            let dx: Vec<Dual> = (0..n).map(|i| Dual::var(x[i], i, n)).collect();
-            black_box(vertex::phi_sum(&spec, true, &dx, &dp))
-        })
-    });
-    c.bench_function("v7/compile_pipeline", |b| {
-        b.iter(|| {
-            let m = VertexModel::build(&spec, true);
-            let g = m.ctx.to_graph();
-            compile(&g, &[m.phi_sum_id()], nv, np, &Options::default()).expect("compiles")
-        })
-    });
+    g.finish();
 }
 
 criterion_group!(benches, bench);

@@ -1,1 +1,3 @@
 //! Geometric checks on evaluated designs: self-intersection, obstacles, verification.
+
+pub mod verify;

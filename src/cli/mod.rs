@@ -2,9 +2,13 @@
 
 use clap::{Parser, Subcommand};
 
+pub mod enumerate;
 pub mod bench;
 pub mod formulas;
+pub mod model;
 pub mod vertex;
+pub mod export;
+pub mod verify;
 
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
 #[derive(Debug, Parser)]
@@ -20,17 +24,29 @@ pub struct Cli {
 pub enum Command {
     /// The PTU for one vertex: unit, internal, start/end and dihedral angles over t.
     Vertex(vertex::VertexArgs),
+    /// Generate every crease pattern graph of a task (rules r1, r2; thesis Table 3).
+    Enumerate(enumerate::EnumerateArgs),
     /// Benchmarks measured in one run (`foldsynth bench vertex …`).
     Bench(bench::BenchArgs),
     /// Symbolic formulas of U, θ, φ of a vertex (plain, LaTeX, Mathematica, Python, DOT).
     Formulas(formulas::FormulasArgs),
+    /// The optimization model of one graph: variables, constraints, compiled, verified.
+    Model(model::ModelArgs),
+    /// Write one design (from a design JSON) as FOLD, SVG, OBJ, STL, GIF or PNG.
+    Export(export::ExportArgs),
+    /// Check a FOLD file: isometry of every folded frame, fold angles, face consistency.
+    Verify(verify::VerifyArgs),
 }
 
 /// Run one parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Vertex(a) => vertex::run(a),
+        Command::Enumerate(args) => enumerate::run(args),
         Command::Bench(a) => bench::run(a),
         Command::Formulas(a) => formulas::run(a),
+        Command::Model(a) => model::run(a),
+        Command::Export(a) => export::run(a),
+        Command::Verify(a) => verify::run(a),
     }
 }

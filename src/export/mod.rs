@@ -1,1 +1,517 @@
 //! Files people open: FOLD, SVG, OBJ/STL, pictures, animations, plots, report.
+//!
+//! Everything here starts from the numeric [`Pattern`] (flat layout plus folded frames)
+//! and a [`DesignMeta`] describing where the design came from (task, rule sequence,
+//! modes, gripping vertex, target points, obstacle). The entry point for one design is
+//! [`write_all`]; the pieces are public for callers that need only one format:
+//!
+//! - [`fold`]: FOLD 1.1/1.2 writer and a reader for any FOLD file,
+//! - [`verify`]: the independent check behind `foldsynth verify`,
+//! - [`svg`]: the crease pattern in Origami Simulator's SVG convention,
+//! - [`render`]: folded states as PNG, SVG and animated GIF,
+//! - [`mesh`]: OBJ and STL of a folded state,
+//! - [`plots`]: the search tree (thesis Fig. 48) and the distribution of designs (Fig. 51),
+//! - [`report`]: the self-contained `report.html`,
+//! - [`samples`]: small patterns with exact rigid motions (tests and demos).
+//!
+//! ```
+//! use foldsynth::export::{samples, DesignMeta, ExportOptions, write_all};
+//! let pattern = samples::single_crease(std::f64::consts::FRAC_PI_2, 5);
+//! let meta = DesignMeta { task: "demo".into(), ..DesignMeta::default() };
+//! let dir = tempfile::tempdir().unwrap();
+//! let files = write_all(dir.path(), &pattern, &meta, &ExportOptions::default()).unwrap();
+//! assert!(files.fold.exists());
+//! ```
+
+pub mod fold;
+pub mod geom;
+pub mod mesh;
+pub mod plots;
+pub mod render;
+pub mod report;
+pub mod samples;
+pub mod svg;
+pub mod verify;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::pattern::Pattern;
+
+/// Rigid-body mode of an internal vertex (thesis Eq. 23): M↑ or M↓.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// M = +1 ("up").
+    Up,
+    /// M = −1 ("down").
+    Down,
+}
+
+impl Mode {
+    /// The string used in files: `"up"` or `"down"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Mode::Up => "up",
+            Mode::Down => "down",
+        }
+    }
+}
+
+/// A point the design should reach, optionally at a given driving parameter `t`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TargetPoint {
+    /// Position in 3D.
+    pub p: [f64; 3],
+    /// The driving parameter at which the gripping vertex should be at `p`, if any.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t: Option<f64>,
+}
+
+/// A cylindrical obstacle: the axis segment from `a` to `b` and a radius.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cylinder {
+    /// One end of the axis.
+    pub a: [f64; 3],
+    /// The other end of the axis.
+    pub b: [f64; 3],
+    /// Radius (> 0).
+    pub radius: f64,
+}
+
+/// Where a design came from and what it should do; filled by the synthesis stage.
+///
+/// Serialized with snake_case keys; every field but `task` may be omitted.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DesignMeta {
+    /// Name of the design task (e.g. `"gripper"`).
+    pub task: String,
+    /// Rule application sequence in the thesis's notation, e.g. `"2, 3, (4, 8)"`.
+    #[serde(default)]
+    pub rule_sequence: String,
+    /// RBM of every internal vertex, in the order of the internal vertices.
+    #[serde(default)]
+    pub modes: Vec<Mode>,
+    /// The gripping vertex, a 0-based index into [`Pattern::vertices`].
+    #[serde(default)]
+    pub gripping_vertex: Option<usize>,
+    /// The objective value Ω* of the optimized design.
+    #[serde(default)]
+    pub objective: Option<f64>,
+    /// Target points (gripper: P_G; robotic arm: P_Ti with their t_i).
+    #[serde(default)]
+    pub targets: Vec<TargetPoint>,
+    /// A trajectory to draw as a polyline (e.g. the robotic arm's arc).
+    #[serde(default)]
+    pub trajectory: Vec<[f64; 3]>,
+    /// An obstacle to draw (gripper task).
+    #[serde(default)]
+    pub obstacle: Option<Cylinder>,
+    /// Draw (and mesh) a second arm: the pattern rotated 180° about z (two-armed gripper).
+    #[serde(default)]
+    pub second_arm: bool,
+    /// Anything else worth keeping (written to FOLD under `foldsynth:extra`).
+    #[serde(default)]
+    pub extra: BTreeMap<String, serde_json::Value>,
+}
+
+/// Errors of the export stage.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    /// The input (pattern, metadata, plot data) is not usable; `what` names the field.
+    #[error("{what}: {message}")]
+    Invalid {
+        /// The offending field, e.g. `pattern.edges[3].v[1]`.
+        what: String,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+    /// A FOLD file could not be read.
+    #[error(transparent)]
+    Fold(#[from] fold::FoldError),
+    /// Reading or writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// Encoding an image failed.
+    #[error("image encoding: {0}")]
+    Image(String),
+}
+
+impl ExportError {
+    pub(crate) fn invalid(what: impl Into<String>, message: impl Into<String>) -> Self {
+        ExportError::Invalid {
+            what: what.into(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Result type of this module.
+pub type Result<T, E = ExportError> = std::result::Result<T, E>;
+
+/// Write `bytes` to `path`, mapping the error to [`ExportError::Io`].
+pub(crate) fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
+    std::fs::write(path, bytes).map_err(|source| ExportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn check_finite(what: impl FnOnce() -> String, xs: &[f64]) -> Result<()> {
+    if xs.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(ExportError::invalid(what(), "non-finite number"))
+    }
+}
+
+/// Check that a pattern is self-consistent: indices in range, lengths matching, finite
+/// numbers, faces with at least 3 vertices. Every writer calls this first, so bad input
+/// (e.g. a hand-edited design JSON) gets an error naming the field instead of a panic.
+pub fn validate_pattern(p: &Pattern) -> Result<()> {
+    let n = p.vertices.len();
+    if n == 0 {
+        return Err(ExportError::invalid("pattern.vertices", "empty"));
+    }
+    for (i, v) in p.vertices.iter().enumerate() {
+        check_finite(|| format!("pattern.vertices[{i}]"), v)?;
+    }
+    for (i, e) in p.edges.iter().enumerate() {
+        for k in 0..2 {
+            if e.v[k] >= n {
+                return Err(ExportError::invalid(
+                    format!("pattern.edges[{i}].v[{k}]"),
+                    format!(
+                        "vertex {} out of range (the pattern has {n} vertices)",
+                        e.v[k]
+                    ),
+                ));
+            }
+        }
+        if e.v[0] == e.v[1] {
+            return Err(ExportError::invalid(
+                format!("pattern.edges[{i}].v"),
+                "both ends are the same vertex",
+            ));
+        }
+    }
+    for (i, f) in p.faces.iter().enumerate() {
+        if f.len() < 3 {
+            return Err(ExportError::invalid(
+                format!("pattern.faces[{i}]"),
+                format!("{} vertices; a face needs at least 3", f.len()),
+            ));
+        }
+        for (k, &v) in f.iter().enumerate() {
+            if v >= n {
+                return Err(ExportError::invalid(
+                    format!("pattern.faces[{i}][{k}]"),
+                    format!("vertex {v} out of range (the pattern has {n} vertices)"),
+                ));
+            }
+        }
+    }
+    for (j, fr) in p.frames.iter().enumerate() {
+        if !fr.t.is_finite() {
+            return Err(ExportError::invalid(
+                format!("pattern.frames[{j}].t"),
+                "non-finite number",
+            ));
+        }
+        if fr.coords.len() != n {
+            return Err(ExportError::invalid(
+                format!("pattern.frames[{j}].coords"),
+                format!("{} entries, expected one per vertex ({n})", fr.coords.len()),
+            ));
+        }
+        if fr.fold_angles.len() != p.edges.len() {
+            return Err(ExportError::invalid(
+                format!("pattern.frames[{j}].fold_angles"),
+                format!(
+                    "{} entries, expected one per edge ({})",
+                    fr.fold_angles.len(),
+                    p.edges.len()
+                ),
+            ));
+        }
+        for (i, c) in fr.coords.iter().enumerate() {
+            check_finite(|| format!("pattern.frames[{j}].coords[{i}]"), c)?;
+        }
+        check_finite(
+            || format!("pattern.frames[{j}].fold_angles"),
+            &fr.fold_angles,
+        )?;
+    }
+    Ok(())
+}
+
+/// Check the metadata against the pattern it describes.
+pub fn validate_meta(meta: &DesignMeta, p: &Pattern) -> Result<()> {
+    if let Some(g) = meta.gripping_vertex
+        && g >= p.vertices.len()
+    {
+        return Err(ExportError::invalid(
+            "meta.gripping_vertex",
+            format!(
+                "vertex {g} out of range (the pattern has {} vertices; 0-based)",
+                p.vertices.len()
+            ),
+        ));
+    }
+    if let Some(o) = meta.objective
+        && !o.is_finite()
+    {
+        return Err(ExportError::invalid("meta.objective", "non-finite number"));
+    }
+    for (i, tp) in meta.targets.iter().enumerate() {
+        check_finite(|| format!("meta.targets[{i}].p"), &tp.p)?;
+        if let Some(t) = tp.t {
+            check_finite(|| format!("meta.targets[{i}].t"), &[t])?;
+        }
+    }
+    for (i, q) in meta.trajectory.iter().enumerate() {
+        check_finite(|| format!("meta.trajectory[{i}]"), q)?;
+    }
+    if let Some(c) = &meta.obstacle {
+        check_finite(|| "meta.obstacle.a".into(), &c.a)?;
+        check_finite(|| "meta.obstacle.b".into(), &c.b)?;
+        if !(c.radius.is_finite() && c.radius > 0.0) {
+            return Err(ExportError::invalid(
+                "meta.obstacle.radius",
+                format!("{} is not allowed; the radius must be > 0", c.radius),
+            ));
+        }
+        if geom::norm(geom::sub(c.b, c.a)) == 0.0 {
+            return Err(ExportError::invalid(
+                "meta.obstacle",
+                "the axis ends a and b coincide",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The FOLD spec version to write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum FoldSpec {
+    /// FOLD 1.1.
+    #[value(name = "1.1")]
+    V1_1,
+    /// FOLD 1.2 (the current version; the default).
+    #[default]
+    #[value(name = "1.2")]
+    V1_2,
+}
+
+impl FoldSpec {
+    /// The number written to `file_spec`.
+    pub fn number(self) -> f64 {
+        match self {
+            FoldSpec::V1_1 => 1.1,
+            FoldSpec::V1_2 => 1.2,
+        }
+    }
+}
+
+/// Options of [`write_all`] and the single-format writers.
+#[derive(Clone, Debug)]
+pub struct ExportOptions {
+    /// Base name of the files (`<name>.fold`, `<name>.svg`, …).
+    pub name: String,
+    /// FOLD spec version written to `file_spec`.
+    pub fold_spec: FoldSpec,
+    /// Vertex numbers in the crease-pattern SVG.
+    pub labels: bool,
+    /// Draw flat creases grey instead of Origami Simulator's yellow (see [`svg`]).
+    pub flat_grey: bool,
+    /// Width and height of raster pictures in pixels.
+    pub image_size: (u32, u32),
+    /// How many folded states to render as PNG/SVG pictures (evenly over the frames).
+    pub picture_states: usize,
+    /// Write the animated GIF.
+    pub gif: bool,
+    /// Delay between GIF frames in hundredths of a second.
+    pub gif_delay_cs: u16,
+    /// At most this many GIF frames (picked evenly over the pattern's frames).
+    pub gif_max_frames: usize,
+    /// The camera of pictures and animation.
+    pub camera: render::Camera,
+    /// Binary STL (`true`) or ASCII STL (`false`).
+    pub stl_binary: bool,
+}
+
+impl Default for ExportOptions {
+    fn default() -> Self {
+        ExportOptions {
+            name: "design".into(),
+            fold_spec: FoldSpec::default(),
+            labels: false,
+            flat_grey: false,
+            image_size: (480, 360),
+            picture_states: 4,
+            gif: true,
+            gif_delay_cs: 8,
+            gif_max_frames: 60,
+            camera: render::Camera::default(),
+            stl_binary: true,
+        }
+    }
+}
+
+/// The files [`write_all`] wrote for one design.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Files {
+    /// The FOLD file (crease pattern plus every folded frame).
+    pub fold: PathBuf,
+    /// The crease pattern SVG (Origami Simulator convention).
+    pub svg: PathBuf,
+    /// OBJ of the final folded state.
+    pub obj: PathBuf,
+    /// STL of the final folded state.
+    pub stl: PathBuf,
+    /// PNG pictures of selected folded states, in order of t.
+    pub pngs: Vec<PathBuf>,
+    /// SVG pictures of the same folded states.
+    pub folded_svgs: Vec<PathBuf>,
+    /// The animated GIF of the motion, if written.
+    pub gif: Option<PathBuf>,
+}
+
+/// Indices of `count` frames spread evenly over `n` frames, always including the last.
+pub fn picked_frames(n: usize, count: usize) -> Vec<usize> {
+    if n == 0 || count == 0 {
+        return Vec::new();
+    }
+    if count >= n {
+        return (0..n).collect();
+    }
+    if count == 1 {
+        return vec![n - 1];
+    }
+    let mut out: Vec<usize> = (0..count)
+        .map(|k| ((k as f64) * (n - 1) as f64 / (count - 1) as f64).round() as usize)
+        .collect();
+    out.dedup();
+    out
+}
+
+/// Write every file for one design into `out_dir` (created if missing): FOLD, crease
+/// pattern SVG, OBJ and STL of the final state, PNG and SVG pictures of a few states,
+/// and the GIF animation. With `meta.second_arm`, pictures and meshes show both arms.
+pub fn write_all(
+    out_dir: &Path,
+    pattern: &Pattern,
+    meta: &DesignMeta,
+    opts: &ExportOptions,
+) -> Result<Files> {
+    validate_pattern(pattern)?;
+    validate_meta(meta, pattern)?;
+    if opts.name.is_empty() || opts.name.contains(['/', '\\']) {
+        return Err(ExportError::invalid(
+            "options.name",
+            format!("{:?}: must be a plain, non-empty file name", opts.name),
+        ));
+    }
+    std::fs::create_dir_all(out_dir).map_err(|source| ExportError::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let path = |ext: &str| out_dir.join(format!("{}.{ext}", opts.name));
+    let mut files = Files {
+        fold: path("fold"),
+        svg: path("svg"),
+        obj: path("obj"),
+        stl: path("stl"),
+        ..Files::default()
+    };
+    write_file(
+        &files.fold,
+        fold::to_fold_string(pattern, meta, opts.fold_spec)?,
+    )?;
+    write_file(
+        &files.svg,
+        svg::crease_pattern_svg(
+            pattern,
+            &svg::SvgOptions {
+                labels: opts.labels,
+                flat_grey: opts.flat_grey,
+                ..svg::SvgOptions::default()
+            },
+        )?,
+    )?;
+    let last = pattern.frames.len().checked_sub(1);
+    let state = mesh::state_mesh(pattern, last, meta.second_arm)?;
+    write_file(&files.obj, mesh::to_obj(&state, &opts.name))?;
+    let stl = if opts.stl_binary {
+        mesh::to_stl_binary(&state)
+    } else {
+        mesh::to_stl_ascii(&state, &opts.name).into_bytes()
+    };
+    write_file(&files.stl, stl)?;
+
+    let scene = render::Scene::new(pattern, meta, opts.camera)?;
+    for k in picked_frames(pattern.frames.len(), opts.picture_states) {
+        let png = out_dir.join(format!("{}_state{k}.png", opts.name));
+        write_file(&png, scene.png(Some(k), opts.image_size)?)?;
+        files.pngs.push(png);
+        let fsvg = out_dir.join(format!("{}_state{k}.svg", opts.name));
+        write_file(&fsvg, scene.svg(Some(k), opts.image_size))?;
+        files.folded_svgs.push(fsvg);
+    }
+    if opts.gif && !pattern.frames.is_empty() {
+        let gif = path("gif");
+        write_file(
+            &gif,
+            scene.gif(opts.image_size, opts.gif_delay_cs, opts.gif_max_frames)?,
+        )?;
+        files.gif = Some(gif);
+    }
+    Ok(files)
+}
+
+/// The JSON file `foldsynth export` reads: `{"pattern": <Pattern>, "meta": <DesignMeta>}`.
+///
+/// `pattern` is [`Pattern`] as serde writes it (`vertices`, `edges` with
+/// `{"v": [i, j], "kind": "boundary" | {"crease": {"driven": bool}}}`, `faces`, `frames`
+/// with `t`, `coords`, `fold_angles` in radians); `meta` is [`DesignMeta`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DesignFile {
+    /// The crease pattern and its folded states.
+    pub pattern: Pattern,
+    /// What the design is for.
+    #[serde(default)]
+    pub meta: DesignMeta,
+}
+
+impl DesignFile {
+    /// Read and validate a design JSON file.
+    pub fn read(path: &Path) -> Result<DesignFile> {
+        let text = std::fs::read_to_string(path).map_err(|source| ExportError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let d: DesignFile = serde_json::from_str(&text).map_err(|e| {
+            ExportError::invalid(
+                path.display().to_string(),
+                format!(
+                    "not a design file ({e}); expected {{\"pattern\": {{vertices, edges, faces, frames}}, \"meta\": {{task, …}}}}"
+                ),
+            )
+        })?;
+        validate_pattern(&d.pattern)
+            .and_then(|()| validate_meta(&d.meta, &d.pattern))
+            .map_err(|e| ExportError::invalid(path.display().to_string(), e.to_string()))?;
+        Ok(d)
+    }
+}

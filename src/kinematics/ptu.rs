@@ -55,54 +55,34 @@ pub struct UnitAngles<S> {
     pub delta: S,
 }
 
-/// Rotate `v` about the x-axis by the angle with cosine `c` and sine `s`.
-#[inline]
-fn rot_x<S: Scalar>(v: [S; 3], c: &S, s: &S) -> [S; 3] {
-    let [x, y, z] = v;
-    [
-        x,
-        y.clone() * c.clone() - z.clone() * s.clone(),
-        y * s.clone() + z * c.clone(),
-    ]
-}
-
-/// Rotate `v` about the z-axis by the angle with cosine `c` and sine `s`.
-#[inline]
-fn rot_z<S: Scalar>(v: [S; 3], c: &S, s: &S) -> [S; 3] {
-    let [x, y, z] = v;
-    [
-        x.clone() * c.clone() - y.clone() * s.clone(),
-        x * s.clone() + y * c.clone(),
-        z,
-    ]
-}
-
-/// `P_jm` of Eq. 17: the unit's last crease direction when its first sector lies in the
-/// xy-plane with its first crease on the x-axis.
-fn chain_end<S: Scalar>(sectors: &[S], driving: &[S]) -> [S; 3] {
+/// The unit's chain `Q = R_z(α_1) R_x(ρ_1) … R_x(ρ_{m-1}) R_z(α_m)` as rows.
+///
+/// Its first column is `P_jm` of Eq. 17 (the last crease seen from the first) and its
+/// first row is `P'_j0` of Eq. 21, because the reversed chain with negated angles is
+/// `Q⁻¹ = Qᵀ`. Building `Q` once shares every sine and cosine between the two.
+fn chain<S: Scalar>(sectors: &[S], driving: &[S]) -> [[S; 3]; 3] {
     let m = sectors.len();
-    let zero = S::from_f64(0.0);
-    let mut v = [sectors[m - 1].cos(), sectors[m - 1].sin(), zero];
-    // Apply R_z(α_i) R_x(ρ_i) for i = m-1 … 1, right to left.
+    let (zero, one) = (S::from_f64(0.0), S::from_f64(1.0));
+    let (c, s) = (sectors[m - 1].cos(), sectors[m - 1].sin());
+    let mut q = [
+        [c.clone(), -s.clone(), zero.clone()],
+        [s, c, zero.clone()],
+        [zero.clone(), zero, one],
+    ];
+    // Left-multiply by R_z(α_i) R_x(ρ_i) for i = m-1 … 1.
     for i in (0..m - 1).rev() {
-        v = rot_x(v, &driving[i].cos(), &driving[i].sin());
-        v = rot_z(v, &sectors[i].cos(), &sectors[i].sin());
+        let (c, s) = (driving[i].cos(), driving[i].sin());
+        let [r0, r1, r2] = q;
+        let r1x: [S; 3] =
+            std::array::from_fn(|k| c.clone() * r1[k].clone() - s.clone() * r2[k].clone());
+        let r2x: [S; 3] =
+            std::array::from_fn(|k| s.clone() * r1[k].clone() + c.clone() * r2[k].clone());
+        let (c, s) = (sectors[i].cos(), sectors[i].sin());
+        let r0z = std::array::from_fn(|k| c.clone() * r0[k].clone() - s.clone() * r1x[k].clone());
+        let r1z = std::array::from_fn(|k| s.clone() * r0[k].clone() + c.clone() * r1x[k].clone());
+        q = [r0z, r1z, r2x];
     }
-    v
-}
-
-/// `P'_j0` of Eq. 21: the reversed chain with negated angles (the first crease seen from
-/// a frame whose x-axis is the last crease and whose xy-plane holds the last sector).
-fn chain_start_reversed<S: Scalar>(sectors: &[S], driving: &[S]) -> [S; 3] {
-    let m = sectors.len();
-    let zero = S::from_f64(0.0);
-    // R_z(-α_m) R_x(-ρ_{m-1}) R_z(-α_{m-1}) … R_x(-ρ_1) R_z(-α_1) e_x, right to left.
-    let mut v = [sectors[0].cos(), -sectors[0].sin(), zero];
-    for i in 0..m - 1 {
-        v = rot_x(v, &driving[i].cos(), &-driving[i].sin());
-        v = rot_z(v, &sectors[i + 1].cos(), &-sectors[i + 1].sin());
-    }
-    v
+    q
 }
 
 /// Unit angle, start and end angle of one unit (Eq. 17–22).
@@ -128,16 +108,15 @@ pub fn unit_angles<S: Scalar>(unit: &Unit<S>) -> UnitAngles<S> {
             delta: S::from_f64(0.0),
         };
     }
-    let [x, y, z] = chain_end(sectors, driving);
+    let [[x, r01, r02], [y, _, _], [z, _, _]] = chain(sectors, driving);
     let u = (y.clone() * y.clone() + z.clone() * z.clone())
         .sqrt()
         .atan2(&x);
     let beta = -z.atan2(&y);
-    // End angle: the same construction on the reversed chain (Eq. 21–22).
-    // There the arc to P'_{m-1} = R_z(-α_m) e_x leaves e_x along -e_y (the reversed chain
-    // turns clockwise), so the angle between the arcs is atan2(|z|, -y).
-    let [_, y0, z0] = chain_start_reversed(sectors, driving);
-    let delta = -z0.atan2(&-y0);
+    // End angle: the same construction on the reversed chain P'_0 = (x, r01, r02). There
+    // the arc to P'_{m-1} = R_z(-α_m) e_x leaves e_x along -e_y (the reversed chain turns
+    // clockwise), so the angle between the arcs is atan2(|z'|, -y').
+    let delta = -r02.atan2(&-r01);
     UnitAngles { u, beta, delta }
 }
 
@@ -309,13 +288,21 @@ mod tests {
     }
 
     #[test]
-    fn end_angle_chain_spans_the_same_unit_angle() {
-        // P'_0 · e_x must equal P_m · e_x: both are cos U.
+    fn chain_rows_are_the_reversed_chain_of_eq21() {
+        // P'_0 computed literally as R_z(-α_m) R_x(-ρ_{m-1}) … R_z(-α_1) e_x.
+        use nalgebra::{Rotation3, Vector3};
         let s = [deg(40.0), deg(70.0), deg(35.0), deg(80.0)];
         let d = [0.4, -1.1, 0.9];
-        let a = chain_end(&s, &d);
-        let b = chain_start_reversed(&s, &d);
-        assert!((a[0] - b[0]).abs() < 1e-14);
+        let rz = |a: f64| Rotation3::from_axis_angle(&Vector3::z_axis(), a);
+        let rx = |a: f64| Rotation3::from_axis_angle(&Vector3::x_axis(), a);
+        let mut p = rz(-s[0]) * Vector3::x();
+        for i in 0..3 {
+            p = rz(-s[i + 1]) * (rx(-d[i]) * p);
+        }
+        let q = chain(&s, &d);
+        for k in 0..3 {
+            assert!((q[0][k] - p[k]).abs() < 1e-14);
+        }
     }
 
     #[test]

@@ -1,0 +1,185 @@
+//! `foldsynth export DESIGN.json --format fold|svg|obj|stl|gif|png|state-svg|all`.
+//!
+//! The design file is `{"pattern": <Pattern>, "meta": <DesignMeta>}` (see
+//! [`crate::export::DesignFile`]); the synthesis stage writes one per feasible design.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+
+use crate::export::{self, DesignFile, ExportOptions, FoldSpec, mesh, render, svg};
+
+/// What to write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// FOLD file with the crease pattern and every folded frame.
+    Fold,
+    /// Crease pattern SVG (Origami Simulator colours).
+    Svg,
+    /// OBJ mesh of one state.
+    Obj,
+    /// STL mesh of one state (binary unless --stl-ascii).
+    Stl,
+    /// Animated GIF of the motion.
+    Gif,
+    /// PNG picture of one state.
+    Png,
+    /// SVG picture of one folded state.
+    StateSvg,
+    /// Everything, into the directory --out.
+    All,
+}
+
+impl Format {
+    fn extension(self) -> &'static str {
+        match self {
+            Format::Fold => "fold",
+            Format::Svg => "svg",
+            Format::Obj => "obj",
+            Format::Stl => "stl",
+            Format::Gif => "gif",
+            Format::Png => "png",
+            Format::StateSvg => "state.svg",
+            Format::All => "export",
+        }
+    }
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT, e.g. 480x360"))?;
+    let p = |x: &str| {
+        x.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("{s:?}: expected WIDTHxHEIGHT in pixels, e.g. 480x360"))
+    };
+    Ok((p(w)?, p(h)?))
+}
+
+/// Arguments of `foldsynth export`.
+#[derive(Debug, clap::Args)]
+pub struct ExportArgs {
+    /// Design JSON: {"pattern": {vertices, edges, faces, frames}, "meta": {task, …}}.
+    pub design: PathBuf,
+    /// Output format.
+    #[arg(long, value_enum)]
+    pub format: Format,
+    /// Output file (a directory for --format all). Default: the design's path with the
+    /// format's extension.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// State for png, obj, stl and state-svg: index into the pattern's frames
+    /// (0-based; default: the last frame).
+    #[arg(long)]
+    pub frame: Option<usize>,
+    /// Vertex numbers in the crease pattern SVG.
+    #[arg(long)]
+    pub labels: bool,
+    /// Grey instead of Origami Simulator's yellow for flat creases.
+    #[arg(long)]
+    pub flat_grey: bool,
+    /// FOLD spec version.
+    #[arg(long, value_enum, default_value = "1.2")]
+    pub spec: FoldSpec,
+    /// ASCII STL instead of binary.
+    #[arg(long)]
+    pub stl_ascii: bool,
+    /// Picture size in pixels.
+    #[arg(long, default_value = "480x360", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Camera azimuth in degrees (about +z, from +x).
+    #[arg(long, default_value_t = -60.0, allow_hyphen_values = true)]
+    pub azimuth: f64,
+    /// Camera elevation in degrees, in (−90, 90).
+    #[arg(long, default_value_t = 25.0, allow_hyphen_values = true)]
+    pub elevation: f64,
+}
+
+fn default_out(design: &Path, f: Format) -> PathBuf {
+    let stem = design
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "design".into());
+    design.with_file_name(format!("{stem}.{}", f.extension()))
+}
+
+/// Run `foldsynth export`.
+pub fn run(a: ExportArgs) -> anyhow::Result<()> {
+    let d = DesignFile::read(&a.design)?;
+    let (p, meta) = (&d.pattern, &d.meta);
+    let out = a
+        .out
+        .clone()
+        .unwrap_or_else(|| default_out(&a.design, a.format));
+    let camera = render::Camera {
+        azimuth_deg: a.azimuth,
+        elevation_deg: a.elevation,
+    };
+    let n = p.frames.len();
+    let frame = match a.frame {
+        Some(k) if k >= n => anyhow::bail!(
+            "--frame {k}: out of range; {} has {n} frames (0-based)",
+            a.design.display()
+        ),
+        Some(k) => Some(k),
+        None => n.checked_sub(1),
+    };
+    let write = |bytes: Vec<u8>| -> anyhow::Result<()> {
+        std::fs::write(&out, bytes).with_context(|| format!("writing {}", out.display()))
+    };
+    match a.format {
+        Format::Fold => write(export::fold::to_fold_string(p, meta, a.spec)?.into_bytes())?,
+        Format::Svg => write(
+            svg::crease_pattern_svg(
+                p,
+                &svg::SvgOptions {
+                    labels: a.labels,
+                    flat_grey: a.flat_grey,
+                    ..svg::SvgOptions::default()
+                },
+            )?
+            .into_bytes(),
+        )?,
+        Format::Obj => write(
+            mesh::to_obj(&mesh::state_mesh(p, frame, meta.second_arm)?, &meta.task).into_bytes(),
+        )?,
+        Format::Stl => {
+            let m = mesh::state_mesh(p, frame, meta.second_arm)?;
+            write(if a.stl_ascii {
+                mesh::to_stl_ascii(&m, &meta.task).into_bytes()
+            } else {
+                mesh::to_stl_binary(&m)
+            })?
+        }
+        Format::Gif => write(render::Scene::new(p, meta, camera)?.gif(a.size, 8, 60)?)?,
+        Format::Png => write(render::Scene::new(p, meta, camera)?.png(frame, a.size)?)?,
+        Format::StateSvg => write(
+            render::Scene::new(p, meta, camera)?
+                .svg(frame, a.size)
+                .into_bytes(),
+        )?,
+        Format::All => {
+            let name = a
+                .design
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "design".into());
+            let opts = ExportOptions {
+                name,
+                fold_spec: a.spec,
+                labels: a.labels,
+                flat_grey: a.flat_grey,
+                image_size: a.size,
+                camera,
+                stl_binary: !a.stl_ascii,
+                ..ExportOptions::default()
+            };
+            let files = export::write_all(&out, p, meta, &opts)?;
+            println!("{}", serde_json::to_string_pretty(&files)?);
+            return Ok(());
+        }
+    }
+    println!("{}", out.display());
+    Ok(())
+}

@@ -1,0 +1,439 @@
+//! Small geometry kernel for the export stage: vectors, face normals, signed fold angles,
+//! corner angles, ear-clipping triangulation, and faces of a planar straight-line graph.
+//!
+//! ## The fold-angle sign
+//!
+//! Faces are counter-clockwise in the flat state, so their right-hand normals point to +z
+//! there. Take a crease from vertex `a` to vertex `b` and call L the face that traverses
+//! `a → b` (the edge has L on its left) and R the face that traverses `b → a`. With unit
+//! normals n_L, n_R and e = (b − a)/|b − a| in the folded state,
+//!
+//! ```text
+//! ρ = atan2((n_R × n_L) · e, n_L · n_R)        (radians, in (−π, π])
+//! ```
+//!
+//! Why this sign is "valley positive": keep R fixed (n_R = +z) and turn L about e by +ρ
+//! (right-hand rule). For e = +x the left side (+y) rises toward +z, the two faces turn
+//! their front sides toward each other: a valley (FOLD: "a valley crease points the two
+//! face normals into each other"). Then n_L = (0, −sin ρ, cos ρ), n_R × n_L = (sin ρ, 0, 0),
+//! so (n_R × n_L)·e = sin ρ and n_L·n_R = cos ρ: the formula returns +ρ. It does not depend
+//! on which face is held fixed (only relative rotation about e enters), and swapping the
+//! edge direction swaps L and R and negates e, which leaves ρ unchanged.
+
+/// A 3D vector.
+pub type V3 = [f64; 3];
+
+/// a − b.
+pub fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// a + b.
+pub fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// s · a.
+pub fn scale(a: V3, s: f64) -> V3 {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+
+/// Dot product.
+pub fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Cross product.
+pub fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Euclidean length.
+pub fn norm(a: V3) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// Distance between two points.
+pub fn dist(a: V3, b: V3) -> f64 {
+    norm(sub(a, b))
+}
+
+/// a / |a|, or `None` for a zero vector.
+pub fn normalize(a: V3) -> Option<V3> {
+    let n = norm(a);
+    (n > 0.0 && n.is_finite()).then(|| scale(a, 1.0 / n))
+}
+
+/// Newell's normal of a polygon: its direction follows the right-hand rule of the vertex
+/// order and its length is twice the (vector) area. Robust for non-convex polygons.
+pub fn newell_normal(pts: &[V3]) -> V3 {
+    let mut n = [0.0; 3];
+    for i in 0..pts.len() {
+        let p = pts[i];
+        let q = pts[(i + 1) % pts.len()];
+        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
+        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
+        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
+    }
+    n
+}
+
+/// Signed area of a 2D polygon (positive when counter-clockwise).
+pub fn signed_area_2d(pts: &[[f64; 2]]) -> f64 {
+    let mut s = 0.0;
+    for i in 0..pts.len() {
+        let p = pts[i];
+        let q = pts[(i + 1) % pts.len()];
+        s += p[0] * q[1] - q[0] * p[1];
+    }
+    0.5 * s
+}
+
+/// Signed fold angle (radians, valley positive) of the crease `a → b` between the face
+/// `left` (traversing a → b) and the face `right` (traversing b → a); see the module docs.
+/// `None` when a face or the crease is degenerate (zero normal or zero length).
+pub fn fold_angle(a: V3, b: V3, left: &[V3], right: &[V3]) -> Option<f64> {
+    let nl = normalize(newell_normal(left))?;
+    let nr = normalize(newell_normal(right))?;
+    let e = normalize(sub(b, a))?;
+    Some(dot(cross(nr, nl), e).atan2(dot(nl, nr)))
+}
+
+/// The interior angle at `v` of a polygon whose boundary runs `prev → v → next` counter-
+/// clockwise about `normal`: the angle from (next − v) to (prev − v), in [0, 2π).
+pub fn corner_angle(prev: V3, v: V3, next: V3, normal: V3) -> f64 {
+    let a = sub(next, v);
+    let b = sub(prev, v);
+    let s = dot(cross(a, b), normal);
+    let c = dot(a, b) * norm(normal);
+    let ang = s.atan2(c);
+    if ang < 0.0 {
+        ang + std::f64::consts::TAU
+    } else {
+        ang
+    }
+}
+
+/// Rotation of `p` by `angle` (right-hand rule) about the axis through the origin along
+/// the unit vector `axis` (Rodrigues' formula).
+pub fn rotate(p: V3, axis: V3, angle: f64) -> V3 {
+    let (s, c) = angle.sin_cos();
+    let kxp = cross(axis, p);
+    let kdp = dot(axis, p);
+    [
+        p[0] * c + kxp[0] * s + axis[0] * kdp * (1.0 - c),
+        p[1] * c + kxp[1] * s + axis[1] * kdp * (1.0 - c),
+        p[2] * c + kxp[2] * s + axis[2] * kdp * (1.0 - c),
+    ]
+}
+
+fn cross2(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+}
+
+/// Ear-clipping triangulation of a simple polygon given counter-clockwise in 2D.
+/// Returns index triples into `poly`, each counter-clockwise. Collinear vertices are kept
+/// as triangle corners where possible; zero-area remainders are dropped.
+pub fn triangulate(poly: &[[f64; 2]]) -> Result<Vec<[usize; 3]>, String> {
+    let n = poly.len();
+    if n < 3 {
+        return Err(format!("a polygon needs 3 vertices, got {n}"));
+    }
+    let area = signed_area_2d(poly);
+    if area <= 0.0 {
+        return Err(format!(
+            "polygon is not counter-clockwise (signed area {area})"
+        ));
+    }
+    // Scale-aware tolerance for "strictly convex": relative to the squared size.
+    let size = poly
+        .iter()
+        .flat_map(|p| poly.iter().map(move |q| (p[0] - q[0]).hypot(p[1] - q[1])))
+        .fold(0.0, f64::max);
+    let eps = 1e-12 * size * size;
+    let mut idx: Vec<usize> = (0..n).collect();
+    let mut tris = Vec::with_capacity(n - 2);
+    while idx.len() > 3 {
+        let m = idx.len();
+        let mut clipped = false;
+        for i in 0..m {
+            let (ip, ic, inx) = (idx[(i + m - 1) % m], idx[i], idx[(i + 1) % m]);
+            let (a, b, c) = (poly[ip], poly[ic], poly[inx]);
+            if cross2(a, b, c) <= eps {
+                continue; // reflex or collinear: not an ear
+            }
+            let blocked = idx.iter().any(|&j| {
+                if j == ip || j == ic || j == inx {
+                    return false;
+                }
+                let p = poly[j];
+                // Inside or on the boundary of the candidate triangle blocks the ear.
+                cross2(a, b, p) >= -eps && cross2(b, c, p) >= -eps && cross2(c, a, p) >= -eps
+            });
+            if !blocked {
+                tris.push([ip, ic, inx]);
+                idx.remove(i);
+                clipped = true;
+                break;
+            }
+        }
+        if !clipped {
+            // Only collinear vertices left to remove (zero-area strip), or not simple.
+            let m = idx.len();
+            let k = (0..m).find(|&i| {
+                let (a, b, c) = (
+                    poly[idx[(i + m - 1) % m]],
+                    poly[idx[i]],
+                    poly[idx[(i + 1) % m]],
+                );
+                cross2(a, b, c).abs() <= eps
+            });
+            match k {
+                Some(i) => {
+                    idx.remove(i);
+                }
+                None => {
+                    return Err("polygon is not simple (no ear found)".into());
+                }
+            }
+        }
+    }
+    if cross2(poly[idx[0]], poly[idx[1]], poly[idx[2]]) > eps {
+        tris.push([idx[0], idx[1], idx[2]]);
+    }
+    Ok(tris)
+}
+
+/// Faces of a planar straight-line graph: every bounded face, counter-clockwise, found by
+/// walking half-edges (at each vertex turn to the neighbour just clockwise of where we
+/// came from). The unbounded face (clockwise) is dropped, and so is any face all of whose
+/// sides are in `boundary` when there is more than one face (a hole in the sheet).
+pub fn faces_of_planar_graph(
+    coords: &[[f64; 2]],
+    edges: &[[usize; 2]],
+    boundary: &[bool],
+) -> Result<Vec<Vec<usize>>, String> {
+    use std::collections::HashMap;
+    let n = coords.len();
+    let mut nbrs: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for e in edges {
+        if !nbrs[e[0]].contains(&e[1]) {
+            nbrs[e[0]].push(e[1]);
+            nbrs[e[1]].push(e[0]);
+        }
+    }
+    for (v, list) in nbrs.iter_mut().enumerate() {
+        let p = coords[v];
+        list.sort_by(|&a, &b| {
+            let ta = (coords[a][1] - p[1]).atan2(coords[a][0] - p[0]);
+            let tb = (coords[b][1] - p[1]).atan2(coords[b][0] - p[0]);
+            ta.total_cmp(&tb)
+        });
+    }
+    let mut is_boundary: HashMap<(usize, usize), bool> = HashMap::new();
+    for (e, &b) in edges.iter().zip(boundary) {
+        is_boundary.insert((e[0].min(e[1]), e[0].max(e[1])), b);
+    }
+    let mut used: HashMap<(usize, usize), bool> = HashMap::new();
+    let mut faces = Vec::new();
+    for u in 0..n {
+        for &v in &nbrs[u] {
+            if used.contains_key(&(u, v)) {
+                continue;
+            }
+            // Follow half-edges until the walk returns to (u, v): the rotation system
+            // makes "next half-edge" a permutation, so every walk closes.
+            let mut face = Vec::new();
+            let (mut a, mut b) = (u, v);
+            loop {
+                used.insert((a, b), true);
+                face.push(a);
+                if face.len() > 2 * edges.len() + 2 {
+                    return Err("face walk did not close (graph not planar?)".into());
+                }
+                // Next half-edge: at b, the neighbour preceding a in ccw order.
+                let list = &nbrs[b];
+                let pos = list
+                    .iter()
+                    .position(|&w| w == a)
+                    .ok_or("broken adjacency")?;
+                let w = list[(pos + list.len() - 1) % list.len()];
+                (a, b) = (b, w);
+                if (a, b) == (u, v) {
+                    break;
+                }
+            }
+            faces.push(face);
+        }
+    }
+    let ccw: Vec<Vec<usize>> = faces
+        .into_iter()
+        .filter(|f| {
+            let pts: Vec<[f64; 2]> = f.iter().map(|&i| coords[i]).collect();
+            f.len() >= 3 && signed_area_2d(&pts) > 0.0
+        })
+        .collect();
+    if ccw.len() <= 1 {
+        return Ok(ccw);
+    }
+    Ok(ccw
+        .into_iter()
+        .filter(|f| {
+            !(0..f.len()).all(|i| {
+                let (a, b) = (f[i], f[(i + 1) % f.len()]);
+                is_boundary
+                    .get(&(a.min(b), a.max(b)))
+                    .copied()
+                    .unwrap_or(false)
+            })
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    /// Square [0,2]×[−1,1] cut by the crease (0,0)→(2,0); left face y ≥ 0.
+    fn two_faces(left_up: V3, right_up: V3) -> (Vec<V3>, Vec<V3>) {
+        // Left face ccw: a=(0,0), b=(2,0), (2,1), (0,1) mapped to 3D.
+        let a = [0.0, 0.0, 0.0];
+        let b = [2.0, 0.0, 0.0];
+        let left = vec![a, b, add(b, left_up), add(a, left_up)];
+        // Right face ccw: b, a, (0,-1), (2,-1).
+        let right = vec![b, a, add(a, right_up), add(b, right_up)];
+        (left, right)
+    }
+
+    #[test]
+    fn flat_is_zero() {
+        let (l, r) = two_faces([0.0, 1.0, 0.0], [0.0, -1.0, 0.0]);
+        let rho = fold_angle([0.0; 3], [2.0, 0.0, 0.0], &l, &r).unwrap();
+        assert!(rho.abs() < 1e-15);
+    }
+
+    #[test]
+    fn both_faces_rising_is_valley() {
+        let s = (PI / 4.0).sin();
+        let c = (PI / 4.0).cos();
+        // Left face turned up by 45°, right face up by 45°: valley of 90°.
+        let (l, r) = two_faces([0.0, c, s], [0.0, -c, s]);
+        let rho = fold_angle([0.0; 3], [2.0, 0.0, 0.0], &l, &r).unwrap();
+        assert!((rho - FRAC_PI_2).abs() < 1e-14, "{rho}");
+        // Both falling: mountain of 90°.
+        let (l, r) = two_faces([0.0, c, -s], [0.0, -c, -s]);
+        let rho = fold_angle([0.0; 3], [2.0, 0.0, 0.0], &l, &r).unwrap();
+        assert!((rho + FRAC_PI_2).abs() < 1e-14, "{rho}");
+    }
+
+    #[test]
+    fn one_face_fixed_large_angles() {
+        for deg in [-170.0f64, -150.0, -30.0, 10.0, 120.0, 150.0, 179.0] {
+            let r = deg.to_radians();
+            // Right face fixed; left face's free side at (0, cos ρ, sin ρ).
+            let (l, rt) = two_faces([0.0, r.cos(), r.sin()], [0.0, -1.0, 0.0]);
+            let rho = fold_angle([0.0; 3], [2.0, 0.0, 0.0], &l, &rt).unwrap();
+            assert!((rho - r).abs() < 1e-14, "{deg}: {}", rho.to_degrees());
+            // Reversing the edge direction swaps the faces' roles: same angle.
+            let rho2 = fold_angle([2.0, 0.0, 0.0], [0.0; 3], &rt, &l).unwrap();
+            assert!((rho2 - r).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn rigid_motion_does_not_change_the_angle() {
+        let r = 1.1f64;
+        let (l, rt) = two_faces([0.0, r.cos(), r.sin()], [0.0, -1.0, 0.0]);
+        let axis = normalize([0.3, -0.5, 0.8]).unwrap();
+        let m = |p: V3| add(rotate(p, axis, 2.3), [5.0, -1.0, 0.25]);
+        let l2: Vec<V3> = l.iter().map(|&p| m(p)).collect();
+        let r2: Vec<V3> = rt.iter().map(|&p| m(p)).collect();
+        let rho = fold_angle(m([0.0; 3]), m([2.0, 0.0, 0.0]), &l2, &r2).unwrap();
+        assert!((rho - r).abs() < 1e-13);
+    }
+
+    #[test]
+    fn corner_angles_of_non_convex_polygon_sum_up() {
+        // An L-shape (ccw): interior angles sum to (n − 2)π, one of them 3π/2.
+        let p: Vec<V3> = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 1.0],
+            [1.0, 1.0],
+            [1.0, 2.0],
+            [0.0, 2.0],
+        ]
+        .iter()
+        .map(|q| [q[0], q[1], 0.0])
+        .collect();
+        let n = newell_normal(&p);
+        let angles: Vec<f64> = (0..6)
+            .map(|i| corner_angle(p[(i + 5) % 6], p[i], p[(i + 1) % 6], n))
+            .collect();
+        let sum: f64 = angles.iter().sum();
+        assert!((sum - 4.0 * PI).abs() < 1e-12);
+        assert!((angles[3] - 1.5 * PI).abs() < 1e-12);
+    }
+
+    fn tri_area(poly: &[[f64; 2]], t: &[usize; 3]) -> f64 {
+        signed_area_2d(&[poly[t[0]], poly[t[1]], poly[t[2]]])
+    }
+
+    #[test]
+    fn ear_clipping_covers_the_polygon() {
+        let polys: Vec<Vec<[f64; 2]>> = vec![
+            vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+            vec![
+                [0.0, 0.0],
+                [2.0, 0.0],
+                [2.0, 1.0],
+                [1.0, 1.0],
+                [1.0, 2.0],
+                [0.0, 2.0],
+            ],
+            // A comb with two notches.
+            vec![
+                [0.0, 0.0],
+                [5.0, 0.0],
+                [5.0, 3.0],
+                [4.0, 3.0],
+                [4.0, 1.0],
+                [3.0, 1.0],
+                [3.0, 3.0],
+                [2.0, 3.0],
+                [2.0, 1.0],
+                [1.0, 1.0],
+                [1.0, 3.0],
+                [0.0, 3.0],
+            ],
+            // Collinear vertices on a side (a crease ending on the side of a face).
+            vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]],
+        ];
+        for poly in polys {
+            let tris = triangulate(&poly).unwrap();
+            let total: f64 = tris.iter().map(|t| tri_area(&poly, t)).sum();
+            assert!((total - signed_area_2d(&poly)).abs() < 1e-12);
+            assert!(tris.iter().all(|t| tri_area(&poly, t) > 0.0));
+        }
+        assert!(triangulate(&[[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]]).is_err());
+    }
+
+    #[test]
+    fn faces_of_a_square_with_a_diagonal() {
+        let coords = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+        let edges = [[0, 1], [1, 2], [2, 3], [3, 0], [3, 1]];
+        let b = [true, true, true, true, false];
+        let mut faces = faces_of_planar_graph(&coords, &edges, &b).unwrap();
+        for f in &mut faces {
+            let m = f.iter().enumerate().min_by_key(|x| x.1).unwrap().0;
+            f.rotate_left(m);
+        }
+        faces.sort();
+        assert_eq!(faces, vec![vec![0, 1, 3], vec![1, 2, 3]]);
+    }
+}

@@ -1,0 +1,655 @@
+//! Pictures of folded states: PNG (tiny-skia), SVG, and an animated GIF of the motion.
+//!
+//! An orthographic axonometric camera (azimuth/elevation, z up) projects the scene; facets
+//! are drawn back to front by the depth of their centroid (painter's algorithm), filled
+//! with a colour per side (front = the side whose normal is +z in the flat state) and
+//! shaded by |n · l|, outlined in dark grey. The obstacle cylinder is a shaded,
+//! translucent mesh sorted with the facets. Target points (red), the trajectory (green
+//! polyline) and the gripping vertex with its path over the frames (black) are drawn on
+//! top so they stay visible. With [`DesignMeta::second_arm`] the pattern rotated 180°
+//! about z is drawn as well, in its own colours. The scale is fixed over all frames so an
+//! animation does not jump.
+
+use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
+
+use super::geom::{self, V3};
+use super::{DesignMeta, ExportError, Result, validate_meta, validate_pattern};
+use crate::pattern::Pattern;
+
+/// An orthographic camera looking at the origin from a direction given in degrees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Angle of the viewing direction about +z, from +x (degrees).
+    pub azimuth_deg: f64,
+    /// Angle of the viewing direction above the xy-plane (degrees), in (−90, 90).
+    pub elevation_deg: f64,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera {
+            azimuth_deg: -60.0,
+            elevation_deg: 25.0,
+        }
+    }
+}
+
+impl Camera {
+    /// Screen right, screen up, and the direction toward the viewer (all unit vectors).
+    pub fn basis(&self) -> (V3, V3, V3) {
+        let (az, el) = (
+            self.azimuth_deg.to_radians(),
+            self.elevation_deg.to_radians(),
+        );
+        let dir = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
+        let right = geom::normalize(geom::cross([0.0, 0.0, 1.0], dir)).unwrap_or([1.0, 0.0, 0.0]);
+        let up = geom::cross(dir, right);
+        (right, up, dir)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Rgba(u8, u8, u8, u8);
+
+impl Rgba {
+    fn shade(self, k: f64) -> Rgba {
+        let f = |c: u8| (c as f64 * k).round().clamp(0.0, 255.0) as u8;
+        Rgba(f(self.0), f(self.1), f(self.2), self.3)
+    }
+    fn hex(self) -> String {
+        format!("#{:02x}{:02x}{:02x}", self.0, self.1, self.2)
+    }
+    fn opacity(self) -> f64 {
+        self.3 as f64 / 255.0
+    }
+}
+
+const FRONT: Rgba = Rgba(242, 200, 121, 255);
+const BACK: Rgba = Rgba(127, 167, 217, 255);
+const FRONT2: Rgba = Rgba(232, 168, 124, 255);
+const BACK2: Rgba = Rgba(143, 185, 168, 255);
+const OBSTACLE: Rgba = Rgba(150, 156, 166, 150);
+const OUTLINE: Rgba = Rgba(50, 50, 50, 255);
+const TARGET: Rgba = Rgba(220, 30, 30, 255);
+const TRAJECTORY: Rgba = Rgba(20, 150, 60, 255);
+
+/// A 2D item of a picture, in world-projected coordinates (not yet fitted to pixels).
+#[derive(Clone, Debug)]
+enum Item {
+    Polygon {
+        pts: Vec<[f64; 2]>,
+        fill: Rgba,
+        outline: Option<Rgba>,
+    },
+    Polyline {
+        pts: Vec<[f64; 2]>,
+        color: Rgba,
+        width: f64,
+        dashed: bool,
+    },
+    Dot {
+        at: [f64; 2],
+        color: Rgba,
+        radius: f64,
+    },
+}
+
+/// A design ready to be drawn: pattern, metadata and camera, with a fixed fit to the image.
+pub struct Scene<'a> {
+    pattern: &'a Pattern,
+    meta: &'a DesignMeta,
+    camera: Camera,
+    lo: [f64; 2],
+    hi: [f64; 2],
+}
+
+fn mirror_z(p: V3) -> V3 {
+    [-p[0], -p[1], p[2]]
+}
+
+fn cylinder_polys(c: &super::Cylinder, segments: usize) -> Vec<Vec<V3>> {
+    let axis = geom::sub(c.b, c.a);
+    let Some(w) = geom::normalize(axis) else {
+        return Vec::new();
+    };
+    let helper = if w[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let u = geom::normalize(geom::cross(w, helper)).unwrap_or([0.0, 0.0, 1.0]);
+    let v = geom::cross(w, u);
+    let ring = |base: V3, k: usize| {
+        let th = std::f64::consts::TAU * k as f64 / segments as f64;
+        geom::add(
+            base,
+            geom::add(
+                geom::scale(u, c.radius * th.cos()),
+                geom::scale(v, c.radius * th.sin()),
+            ),
+        )
+    };
+    let mut polys = Vec::new();
+    for k in 0..segments {
+        polys.push(vec![
+            ring(c.a, k),
+            ring(c.a, k + 1),
+            ring(c.b, k + 1),
+            ring(c.b, k),
+        ]);
+    }
+    polys.push((0..segments).rev().map(|k| ring(c.a, k)).collect());
+    polys.push((0..segments).map(|k| ring(c.b, k)).collect());
+    polys
+}
+
+impl<'a> Scene<'a> {
+    /// Prepare a scene; validates the pattern and metadata.
+    pub fn new(pattern: &'a Pattern, meta: &'a DesignMeta, camera: Camera) -> Result<Scene<'a>> {
+        validate_pattern(pattern)?;
+        validate_meta(meta, pattern)?;
+        if !(camera.elevation_deg.abs() < 90.0 && camera.azimuth_deg.is_finite()) {
+            return Err(ExportError::invalid(
+                "camera",
+                "elevation must be in (−90°, 90°) and azimuth finite",
+            ));
+        }
+        let mut s = Scene {
+            pattern,
+            meta,
+            camera,
+            lo: [f64::INFINITY; 2],
+            hi: [f64::NEG_INFINITY; 2],
+        };
+        let mut pts: Vec<V3> = Vec::new();
+        let states: Vec<Vec<V3>> = if pattern.frames.is_empty() {
+            vec![pattern.flat_coords()]
+        } else {
+            pattern.frames.iter().map(|f| f.coords.clone()).collect()
+        };
+        for st in &states {
+            pts.extend(st.iter().copied());
+            if meta.second_arm {
+                pts.extend(st.iter().map(|&p| mirror_z(p)));
+            }
+        }
+        pts.extend(meta.targets.iter().map(|t| t.p));
+        pts.extend(meta.trajectory.iter().copied());
+        if let Some(c) = &meta.obstacle {
+            pts.extend(cylinder_polys(c, 24).into_iter().flatten());
+        }
+        for p in pts {
+            let q = s.project(p);
+            for ((lo, hi), x) in s.lo.iter_mut().zip(s.hi.iter_mut()).zip(q) {
+                *lo = lo.min(x);
+                *hi = hi.max(x);
+            }
+        }
+        Ok(s)
+    }
+
+    fn project(&self, p: V3) -> [f64; 2] {
+        let (r, u, _) = self.camera.basis();
+        [geom::dot(p, r), geom::dot(p, u)]
+    }
+
+    fn depth(&self, p: V3) -> f64 {
+        geom::dot(p, self.camera.basis().2)
+    }
+
+    fn coords(&self, frame: Option<usize>) -> Vec<V3> {
+        match frame.and_then(|k| self.pattern.frames.get(k)) {
+            Some(f) => f.coords.clone(),
+            None => self.pattern.flat_coords(),
+        }
+    }
+
+    /// The items of one state, back to front.
+    fn items(&self, frame: Option<usize>) -> Vec<Item> {
+        let (_, up, dir) = self.camera.basis();
+        let light = geom::normalize(geom::add(dir, geom::scale(up, 0.6))).unwrap_or(dir);
+        let coords = self.coords(frame);
+        let mut polys: Vec<(f64, Item)> = Vec::new();
+        let mut add_poly = |pts3: &[V3], front: Rgba, back: Rgba, outline: Option<Rgba>| {
+            let n = geom::normalize(geom::newell_normal(pts3)).unwrap_or(dir);
+            let facing = geom::dot(n, dir) >= 0.0;
+            let base = if facing { front } else { back };
+            let k = 0.45 + 0.55 * geom::dot(n, light).abs();
+            let c = pts3.iter().fold([0.0; 3], |a, &p| geom::add(a, p));
+            let depth = self.depth(geom::scale(c, 1.0 / pts3.len() as f64));
+            polys.push((
+                depth,
+                Item::Polygon {
+                    pts: pts3.iter().map(|&p| self.project(p)).collect(),
+                    fill: base.shade(k),
+                    outline,
+                },
+            ));
+        };
+        for f in &self.pattern.faces {
+            let pts: Vec<V3> = f.iter().map(|&v| coords[v]).collect();
+            add_poly(&pts, FRONT, BACK, Some(OUTLINE));
+            if self.meta.second_arm {
+                // Rotating by 180° about z keeps orientation, so the normal rule holds.
+                let pts2: Vec<V3> = pts.iter().map(|&p| mirror_z(p)).collect();
+                add_poly(&pts2, FRONT2, BACK2, Some(OUTLINE));
+            }
+        }
+        if let Some(c) = &self.meta.obstacle {
+            for poly in cylinder_polys(c, 24) {
+                add_poly(&poly, OBSTACLE, OBSTACLE, None);
+            }
+        }
+        polys.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut items: Vec<Item> = polys.into_iter().map(|(_, it)| it).collect();
+
+        if self.meta.trajectory.len() >= 2 {
+            items.push(Item::Polyline {
+                pts: self
+                    .meta
+                    .trajectory
+                    .iter()
+                    .map(|&p| self.project(p))
+                    .collect(),
+                color: TRAJECTORY,
+                width: 2.0,
+                dashed: false,
+            });
+        }
+        if let Some(g) = self.meta.gripping_vertex {
+            if self.pattern.frames.len() >= 2 {
+                items.push(Item::Polyline {
+                    pts: self
+                        .pattern
+                        .frames
+                        .iter()
+                        .map(|f| self.project(f.coords[g]))
+                        .collect(),
+                    color: OUTLINE,
+                    width: 1.0,
+                    dashed: true,
+                });
+            }
+            items.push(Item::Dot {
+                at: self.project(coords[g]),
+                color: OUTLINE,
+                radius: 3.0,
+            });
+        }
+        for t in &self.meta.targets {
+            items.push(Item::Dot {
+                at: self.project(t.p),
+                color: TARGET,
+                radius: 4.0,
+            });
+        }
+        items
+    }
+
+    /// World-projected point → pixel, fitted with a margin; y grows downward.
+    fn fit(&self, size: (u32, u32)) -> impl Fn([f64; 2]) -> [f64; 2] + use<> {
+        let (w, h) = (size.0 as f64, size.1 as f64);
+        let margin = 0.06 * w.min(h);
+        let span = [
+            (self.hi[0] - self.lo[0]).max(1e-9),
+            (self.hi[1] - self.lo[1]).max(1e-9),
+        ];
+        let s = ((w - 2.0 * margin) / span[0]).min((h - 2.0 * margin) / span[1]);
+        let cx = 0.5 * (self.lo[0] + self.hi[0]);
+        let cy = 0.5 * (self.lo[1] + self.hi[1]);
+        move |p: [f64; 2]| [0.5 * w + s * (p[0] - cx), 0.5 * h - s * (p[1] - cy)]
+    }
+
+    fn check_size(size: (u32, u32)) -> Result<()> {
+        if !(16..=4096).contains(&size.0) || !(16..=4096).contains(&size.1) {
+            return Err(ExportError::invalid(
+                "image size",
+                format!(
+                    "{}×{} pixels; each side must be in 16..=4096",
+                    size.0, size.1
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Draw one state (`frame` index into [`Pattern::frames`]; `None` = flat) to a pixmap.
+    pub fn pixmap(&self, frame: Option<usize>, size: (u32, u32)) -> Result<Pixmap> {
+        Self::check_size(size)?;
+        let mut pm = Pixmap::new(size.0, size.1)
+            .ok_or_else(|| ExportError::Image("cannot allocate the image".into()))?;
+        pm.fill(Color::WHITE);
+        let fit = self.fit(size);
+        let paint_of = |c: Rgba| {
+            let mut p = Paint::default();
+            p.set_color_rgba8(c.0, c.1, c.2, c.3);
+            p.anti_alias = true;
+            p
+        };
+        let path_of = |pts: &[[f64; 2]], close: bool| {
+            let mut pb = PathBuilder::new();
+            for (i, &p) in pts.iter().enumerate() {
+                let q = fit(p);
+                if i == 0 {
+                    pb.move_to(q[0] as f32, q[1] as f32);
+                } else {
+                    pb.line_to(q[0] as f32, q[1] as f32);
+                }
+            }
+            if close {
+                pb.close();
+            }
+            pb.finish()
+        };
+        for item in self.items(frame) {
+            match item {
+                Item::Polygon { pts, fill, outline } => {
+                    let Some(path) = path_of(&pts, true) else {
+                        continue;
+                    };
+                    pm.fill_path(
+                        &path,
+                        &paint_of(fill),
+                        FillRule::Winding,
+                        Transform::identity(),
+                        None,
+                    );
+                    if let Some(o) = outline {
+                        let st = Stroke {
+                            width: 1.0,
+                            ..Stroke::default()
+                        };
+                        pm.stroke_path(&path, &paint_of(o), &st, Transform::identity(), None);
+                    }
+                }
+                Item::Polyline {
+                    pts,
+                    color,
+                    width,
+                    dashed,
+                } => {
+                    let Some(path) = path_of(&pts, false) else {
+                        continue;
+                    };
+                    let st = Stroke {
+                        width: width as f32,
+                        dash: if dashed {
+                            tiny_skia::StrokeDash::new(vec![4.0, 3.0], 0.0)
+                        } else {
+                            None
+                        },
+                        ..Stroke::default()
+                    };
+                    pm.stroke_path(&path, &paint_of(color), &st, Transform::identity(), None);
+                }
+                Item::Dot { at, color, radius } => {
+                    let q = fit(at);
+                    if let Some(path) =
+                        PathBuilder::from_circle(q[0] as f32, q[1] as f32, radius as f32)
+                    {
+                        pm.fill_path(
+                            &path,
+                            &paint_of(color),
+                            FillRule::Winding,
+                            Transform::identity(),
+                            None,
+                        );
+                        let st = Stroke {
+                            width: 1.0,
+                            ..Stroke::default()
+                        };
+                        pm.stroke_path(
+                            &path,
+                            &paint_of(Rgba(255, 255, 255, 255)),
+                            &st,
+                            Transform::identity(),
+                            None,
+                        );
+                    }
+                }
+            }
+        }
+        self.draw_axes(&mut pm, size);
+        Ok(pm)
+    }
+
+    fn axes_lines(&self, size: (u32, u32)) -> Vec<([f64; 2], [f64; 2], Rgba, &'static str)> {
+        let (r, u, _) = self.camera.basis();
+        let origin = [24.0, size.1 as f64 - 24.0];
+        let axes = [
+            ([1.0, 0.0, 0.0], Rgba(200, 40, 40, 255), "x"),
+            ([0.0, 1.0, 0.0], Rgba(40, 150, 40, 255), "y"),
+            ([0.0, 0.0, 1.0], Rgba(40, 70, 200, 255), "z"),
+        ];
+        axes.iter()
+            .map(|&(a, c, name)| {
+                let end = [
+                    origin[0] + 16.0 * geom::dot(a, r),
+                    origin[1] - 16.0 * geom::dot(a, u),
+                ];
+                (origin, end, c, name)
+            })
+            .collect()
+    }
+
+    fn draw_axes(&self, pm: &mut Pixmap, size: (u32, u32)) {
+        for (a, b, c, _) in self.axes_lines(size) {
+            let mut pb = PathBuilder::new();
+            pb.move_to(a[0] as f32, a[1] as f32);
+            pb.line_to(b[0] as f32, b[1] as f32);
+            if let Some(path) = pb.finish() {
+                let mut p = Paint::default();
+                p.set_color_rgba8(c.0, c.1, c.2, c.3);
+                p.anti_alias = true;
+                let st = Stroke {
+                    width: 2.0,
+                    ..Stroke::default()
+                };
+                pm.stroke_path(&path, &p, &st, Transform::identity(), None);
+            }
+        }
+    }
+
+    /// One state as PNG bytes.
+    pub fn png(&self, frame: Option<usize>, size: (u32, u32)) -> Result<Vec<u8>> {
+        self.pixmap(frame, size)?
+            .encode_png()
+            .map_err(|e| ExportError::Image(e.to_string()))
+    }
+
+    /// The motion as an animated GIF (looping, with a pause at the end and a progress bar
+    /// along the bottom edge): at most `max_frames` frames, evenly picked over the
+    /// pattern's frames (first and last included). `delay_cs` is the frame delay in 1/100 s.
+    pub fn gif(&self, size: (u32, u32), delay_cs: u16, max_frames: usize) -> Result<Vec<u8>> {
+        Self::check_size(size)?;
+        let total = self.pattern.frames.len();
+        if total == 0 {
+            return Err(ExportError::invalid(
+                "pattern.frames",
+                "empty: nothing to animate",
+            ));
+        }
+        let picked = super::picked_frames(total, max_frames.max(2));
+        let n = picked.len();
+        let img = |e: gif::EncodingError| ExportError::Image(e.to_string());
+        let mut enc =
+            gif::Encoder::new(Vec::new(), size.0 as u16, size.1 as u16, &[]).map_err(img)?;
+        enc.set_repeat(gif::Repeat::Infinite).map_err(img)?;
+        for (k, &frame_index) in picked.iter().enumerate() {
+            let mut pm = self.pixmap(Some(frame_index), size)?;
+            let frac = if n > 1 {
+                k as f32 / (n - 1) as f32
+            } else {
+                1.0
+            };
+            if let Some(rect) = tiny_skia::Rect::from_xywh(
+                0.0,
+                size.1 as f32 - 4.0,
+                (size.0 as f32 * frac).max(1.0),
+                4.0,
+            ) {
+                let mut p = Paint::default();
+                p.set_color_rgba8(80, 80, 80, 255);
+                pm.fill_rect(rect, &p, Transform::identity(), None);
+            }
+            // Opaque white background: premultiplied RGBA equals straight RGBA here.
+            let mut rgba = pm.take();
+            let mut frame =
+                gif::Frame::from_rgba_speed(size.0 as u16, size.1 as u16, &mut rgba, 10);
+            frame.delay = if k + 1 == n {
+                delay_cs.saturating_mul(8).max(50)
+            } else {
+                delay_cs
+            };
+            enc.write_frame(&frame).map_err(img)?;
+        }
+        enc.into_inner().map_err(img)
+    }
+
+    /// One state as a standalone SVG document (vector version of [`Scene::png`]).
+    pub fn svg(&self, frame: Option<usize>, size: (u32, u32)) -> String {
+        let mut s = format!(
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n{}",
+            self.svg_element(frame, size)
+        );
+        s.push('\n');
+        s
+    }
+
+    /// One state as an `<svg>` element without XML prolog (for inlining into HTML).
+    pub fn svg_element(&self, frame: Option<usize>, size: (u32, u32)) -> String {
+        let fit = self.fit(size);
+        let pts_attr = |pts: &[[f64; 2]]| -> String {
+            pts.iter()
+                .map(|&p| {
+                    let q = fit(p);
+                    format!("{:.2},{:.2}", q[0], q[1])
+                })
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        let mut out = format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">\n<rect width=\"{w}\" height=\"{h}\" fill=\"#ffffff\"/>\n",
+            w = size.0,
+            h = size.1
+        );
+        for item in self.items(frame) {
+            match item {
+                Item::Polygon { pts, fill, outline } => {
+                    let stroke = match outline {
+                        Some(o) => format!(
+                            " stroke=\"{}\" stroke-width=\"1\" stroke-linejoin=\"round\"",
+                            o.hex()
+                        ),
+                        None => String::new(),
+                    };
+                    out += &format!(
+                        "<polygon points=\"{}\" fill=\"{}\" fill-opacity=\"{:.3}\"{stroke}/>\n",
+                        pts_attr(&pts),
+                        fill.hex(),
+                        fill.opacity()
+                    );
+                }
+                Item::Polyline {
+                    pts,
+                    color,
+                    width,
+                    dashed,
+                } => {
+                    out += &format!(
+                        "<polyline points=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{width}\"{}/>\n",
+                        pts_attr(&pts),
+                        color.hex(),
+                        if dashed {
+                            " stroke-dasharray=\"4 3\""
+                        } else {
+                            ""
+                        }
+                    );
+                }
+                Item::Dot { at, color, radius } => {
+                    let q = fit(at);
+                    out += &format!(
+                        "<circle cx=\"{:.2}\" cy=\"{:.2}\" r=\"{radius}\" fill=\"{}\" stroke=\"#ffffff\"/>\n",
+                        q[0],
+                        q[1],
+                        color.hex()
+                    );
+                }
+            }
+        }
+        for (a, b, c, name) in self.axes_lines(size) {
+            out += &format!(
+                "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"{}\" stroke-width=\"2\"/><text x=\"{:.1}\" y=\"{:.1}\" font-family=\"sans-serif\" font-size=\"10\" fill=\"{}\">{name}</text>\n",
+                a[0],
+                a[1],
+                b[0],
+                b[1],
+                c.hex(),
+                b[0] + 2.0,
+                b[1] - 2.0,
+                c.hex()
+            );
+        }
+        let label = match frame.and_then(|k| self.pattern.frames.get(k)) {
+            Some(f) => format!("t = {:.4}", f.t),
+            None => "flat".into(),
+        };
+        out += &format!(
+            "<text x=\"8\" y=\"16\" font-family=\"sans-serif\" font-size=\"13\" fill=\"#333333\">{label}</text>\n</svg>"
+        );
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::export::samples;
+
+    #[test]
+    fn camera_basis_is_orthonormal_and_right_handed() {
+        for (az, el) in [(-60.0, 25.0), (0.0, 0.0), (135.0, -40.0)] {
+            let (r, u, d) = Camera {
+                azimuth_deg: az,
+                elevation_deg: el,
+            }
+            .basis();
+            for (a, b) in [(r, u), (u, d), (r, d)] {
+                assert!(geom::dot(a, b).abs() < 1e-12);
+            }
+            for a in [r, u, d] {
+                assert!((geom::norm(a) - 1.0).abs() < 1e-12);
+            }
+            // right × up points toward the viewer: a right-handed screen frame.
+            assert!(geom::dist(geom::cross(r, u), d) < 1e-12);
+            // z projects upward on screen for |elevation| < 90°.
+            assert!(u[2] > 0.0);
+        }
+    }
+
+    #[test]
+    fn picture_shows_the_sheet_and_the_targets() {
+        let p = samples::single_crease(std::f64::consts::FRAC_PI_2, 3);
+        let meta = DesignMeta {
+            targets: vec![super::super::TargetPoint {
+                p: [0.5, 0.0, 1.0],
+                t: None,
+            }],
+            ..DesignMeta::default()
+        };
+        let scene = Scene::new(&p, &meta, Camera::default()).unwrap();
+        let pm = scene.pixmap(Some(2), (200, 150)).unwrap();
+        let px = |x: u32, y: u32| pm.pixel(x, y).unwrap();
+        // The target's pixel is red.
+        let fit = scene.fit((200, 150));
+        let q = fit(scene.project([0.5, 0.0, 1.0]));
+        let c = px(q[0].round() as u32, q[1].round() as u32);
+        assert!(c.red() > 180 && c.green() < 80 && c.blue() < 80, "{c:?}");
+        // Some pixels are paper-coloured (not white, not grey).
+        let painted = pm.pixels().iter().filter(|c| c.red() != c.blue()).count();
+        assert!(painted > 500);
+        // A corner is background white.
+        assert_eq!(px(199, 0).red(), 255);
+    }
+}

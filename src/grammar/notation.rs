@@ -1,0 +1,198 @@
+//! The thesis's rule-sequence notation (Sec. 5.5.2): `2, 3, (4, 8), 4, (7, 8)` is r1 on v2,
+//! r1 on v3, r2 on v4 and v8, … with the names as they are when each rule applies.
+
+use std::fmt;
+
+use super::graph::CreaseGraph;
+use super::{StepRecord, rules::RuleError};
+use crate::task::Task;
+
+/// One rule application in the notation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Step {
+    /// r1 on the vertex with this name.
+    Extend(usize),
+    /// r2 on the two vertices with these names, written sorted (the larger first only in
+    /// the rare case where both roles match and the second one is meant).
+    Combine(usize, usize),
+}
+
+impl fmt::Display for Step {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Step::Extend(n) => write!(f, "{n}"),
+            Step::Combine(a, b) => write!(f, "({a}, {b})"),
+        }
+    }
+}
+
+/// A sequence string that does not parse, or a step that does not apply.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum NotationError {
+    /// The text is not a sequence.
+    #[error("cannot read rule sequence \"{text}\" at character {pos}: {message}")]
+    Syntax {
+        /// The sequence.
+        text: String,
+        /// 1-based character position.
+        pos: usize,
+        /// What was expected.
+        message: String,
+    },
+    /// A step does not match.
+    #[error("rule sequence \"{text}\", step {index} `{step}` (after \"{before}\"): {error}")]
+    Rule {
+        /// The sequence.
+        text: String,
+        /// 1-based index of the step.
+        index: usize,
+        /// The step.
+        step: Step,
+        /// The steps applied before it.
+        before: String,
+        /// Why it does not apply.
+        error: RuleError,
+    },
+}
+
+/// Write a sequence: steps joined by `", "`.
+pub fn format_sequence(steps: &[Step]) -> String {
+    steps
+        .iter()
+        .map(Step::to_string)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Read a sequence such as `2, 3, (4, 8), 4, (7, 8)` (spaces optional; the empty string is
+/// G0 itself).
+pub fn parse_sequence(text: &str) -> Result<Vec<Step>, NotationError> {
+    let b = text.as_bytes();
+    let mut i = 0;
+    let err = |pos: usize, message: &str| NotationError::Syntax {
+        text: text.to_owned(),
+        pos: pos + 1,
+        message: message.to_owned(),
+    };
+    let skip = |i: &mut usize| {
+        while *i < b.len() && b[*i].is_ascii_whitespace() {
+            *i += 1;
+        }
+    };
+    let number = |i: &mut usize| -> Result<usize, NotationError> {
+        skip(i);
+        let start = *i;
+        while *i < b.len() && b[*i].is_ascii_digit() {
+            *i += 1;
+        }
+        if start == *i {
+            return Err(err(start, "expected a vertex name (a positive integer)"));
+        }
+        match text[start..*i].parse::<usize>() {
+            Ok(n) if n > 0 => Ok(n),
+            _ => Err(err(start, "vertex names are positive integers")),
+        }
+    };
+    let mut steps = Vec::new();
+    skip(&mut i);
+    if i == b.len() {
+        return Ok(steps);
+    }
+    loop {
+        skip(&mut i);
+        if i < b.len() && b[i] == b'(' {
+            i += 1;
+            let x = number(&mut i)?;
+            skip(&mut i);
+            if i >= b.len() || b[i] != b',' {
+                return Err(err(i, "expected `,` between the two names of a pair"));
+            }
+            i += 1;
+            let y = number(&mut i)?;
+            skip(&mut i);
+            if i >= b.len() || b[i] != b')' {
+                return Err(err(i, "expected `)` closing the pair"));
+            }
+            i += 1;
+            if x == y {
+                return Err(err(i - 1, "a pair needs two different vertices"));
+            }
+            steps.push(Step::Combine(x, y));
+        } else {
+            steps.push(Step::Extend(number(&mut i)?));
+        }
+        skip(&mut i);
+        if i == b.len() {
+            return Ok(steps);
+        }
+        if b[i] != b',' {
+            return Err(err(i, "expected `,` between steps"));
+        }
+        i += 1;
+    }
+}
+
+impl CreaseGraph {
+    /// The steps that built this graph, in the notation.
+    pub fn sequence_steps(&self) -> Vec<Step> {
+        self.steps
+            .iter()
+            .map(|s| match s {
+                StepRecord::R1(r) => Step::Extend(r.name),
+                StepRecord::R2(r) => Step::Combine(r.names.0, r.names.1),
+            })
+            .collect()
+    }
+
+    /// The rule sequence that built this graph, e.g. `2, 3, (4, 8)`.
+    pub fn sequence(&self) -> String {
+        format_sequence(&self.sequence_steps())
+    }
+
+    /// Rebuild a graph from G0 of `task` and a rule sequence, applying the rules in order.
+    /// Every step must match (N_max is not enforced: that is the enumeration's limit).
+    pub fn from_sequence(task: &Task, text: &str) -> Result<CreaseGraph, NotationError> {
+        let steps = parse_sequence(text)?;
+        let mut g = CreaseGraph::initial(task);
+        for (k, &step) in steps.iter().enumerate() {
+            g.apply_step(step).map_err(|error| NotationError::Rule {
+                text: text.to_owned(),
+                index: k + 1,
+                step,
+                before: format_sequence(&steps[..k]),
+                error,
+            })?;
+        }
+        Ok(g)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_formats() {
+        let s = parse_sequence("2, 3, (4, 8), 4, (7, 8)").unwrap();
+        assert_eq!(
+            s,
+            vec![
+                Step::Extend(2),
+                Step::Extend(3),
+                Step::Combine(4, 8),
+                Step::Extend(4),
+                Step::Combine(7, 8)
+            ]
+        );
+        assert_eq!(format_sequence(&s), "2, 3, (4, 8), 4, (7, 8)");
+        assert_eq!(parse_sequence("2,3,(4,8)").unwrap().len(), 3);
+        assert!(parse_sequence("  ").unwrap().is_empty());
+    }
+
+    #[test]
+    fn rejects_bad_text() {
+        for t in ["2,", "2 3", "(4 8)", "(4, 8", "x", "0", "(4, 4)", "2,,3"] {
+            assert!(parse_sequence(t).is_err(), "{t}");
+        }
+    }
+}

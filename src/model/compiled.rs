@@ -1,0 +1,153 @@
+//! A model compiled to native code: objective, constraints and all their gradients with
+//! respect to the free variables in one call, with the modes and the times as parameters
+//! (one compiled function serves all 2^N mode assignments).
+
+use super::Model;
+use crate::compile::{self, Compiled, Options};
+use crate::expr::{Ctx, Sym};
+use crate::optimize::{Evaluation, Problem};
+use std::cell::RefCell;
+use std::time::Instant;
+
+/// A compiled [`Model`].
+#[derive(Debug)]
+pub struct CompiledModel {
+    /// The compiled function with its layout and report.
+    pub compiled: Compiled,
+    /// Number of free variables (the model's `free`).
+    pub n_vars: usize,
+    /// Number of constraints.
+    pub n_constraints: usize,
+    /// Number of internal vertices (mode parameters come first).
+    pub n_modes: usize,
+    /// Milliseconds to build the expression graph.
+    pub build_ms: f64,
+    /// Milliseconds from the start of the build to native code (build, simplify,
+    /// differentiate, compile).
+    pub total_ms: f64,
+}
+
+/// The symbolic outputs of `model`: free variable `k` is `Var(k)`, the others are the
+/// constants they are drawn at; parameters are the modes, then `model.times`.
+pub fn symbolic(model: &Model) -> (Ctx, Vec<Sym>) {
+    let ctx = Ctx::new();
+    let free: Vec<Sym> = (0..model.free.len()).map(|k| ctx.var(k)).collect();
+    let vars = model.full_vars(&free);
+    let n = model.plan.internal.len();
+    let modes: Vec<Sym> = (0..n).map(|i| ctx.param(i)).collect();
+    let times: Vec<Sym> = (0..model.times.len()).map(|i| ctx.param(n + i)).collect();
+    let out = model.outputs(&vars, &modes, &times);
+    let mut outputs = vec![out.objective];
+    outputs.extend(out.constraints);
+    (ctx, outputs)
+}
+
+impl CompiledModel {
+    /// Build, simplify, differentiate and compile `model`.
+    pub fn new(model: &Model, opts: &Options) -> Result<CompiledModel, compile::CompileError> {
+        let start = Instant::now();
+        let (ctx, outputs) = symbolic(model);
+        let ids: Vec<_> = outputs.iter().map(|s| ctx.node_id(s)).collect();
+        let graph = ctx.to_graph();
+        let build_ms = start.elapsed().as_secs_f64() * 1e3;
+        let n_params = model.plan.internal.len() + model.times.len();
+        let compiled = compile::compile(&graph, &ids, model.free.len(), n_params, opts)?;
+        Ok(CompiledModel {
+            n_vars: model.free.len(),
+            n_constraints: ids.len() - 1,
+            n_modes: model.plan.internal.len(),
+            compiled,
+            build_ms,
+            total_ms: start.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+
+    /// The parameter vector for the given modes (±1) and the model's times.
+    pub fn params(&self, model: &Model, modes: &[f64]) -> Vec<f64> {
+        let mut p = modes.to_vec();
+        p.extend_from_slice(&model.times);
+        p
+    }
+
+    /// Evaluate into `out` (sized [`CompiledModel::buffer_len`]).
+    pub fn call(&self, free: &[f64], params: &[f64], out: &mut [f64]) {
+        self.compiled.function.call(free, params, out).expect("buffer sizes match the compiled layout");
+    }
+
+    /// Length of the output buffer.
+    pub fn buffer_len(&self) -> usize {
+        self.compiled.layout.len()
+    }
+
+    /// Copy one evaluation from the output buffer into an optimizer [`Evaluation`].
+    pub fn unpack(&self, buf: &[f64], e: &mut Evaluation) {
+        let l = &self.compiled.layout;
+        e.f = buf[l.value(0)];
+        if l.gradients {
+            e.df.copy_from_slice(&buf[l.gradient(0)]);
+        }
+        for k in 0..self.n_constraints {
+            e.g[k] = buf[l.value(k + 1)];
+            if l.gradients {
+                let n = self.n_vars;
+                e.dg[k * n..(k + 1) * n].copy_from_slice(&buf[l.gradient(k + 1)]);
+            }
+        }
+    }
+}
+
+/// A compiled model with its modes fixed: an optimization [`Problem`].
+pub struct ModelProblem<'a> {
+    model: &'a Model,
+    compiled: &'a CompiledModel,
+    params: Vec<f64>,
+    buf: RefCell<Vec<f64>>,
+}
+
+impl<'a> ModelProblem<'a> {
+    /// The problem of `model` with the given modes.
+    pub fn new(model: &'a Model, compiled: &'a CompiledModel, modes: &[f64]) -> ModelProblem<'a> {
+        ModelProblem {
+            model,
+            compiled,
+            params: compiled.params(model, modes),
+            buf: RefCell::new(vec![0.0; compiled.buffer_len()]),
+        }
+    }
+}
+
+impl Problem for ModelProblem<'_> {
+    fn n_vars(&self) -> usize {
+        self.compiled.n_vars
+    }
+    fn n_constraints(&self) -> usize {
+        self.compiled.n_constraints
+    }
+    fn bounds(&self, i: usize) -> (f64, f64) {
+        self.model.var_bounds(self.model.free[i])
+    }
+    fn eval(&self, x: &[f64], out: &mut Evaluation) {
+        let mut buf = self.buf.borrow_mut();
+        self.compiled.call(x, &self.params, &mut buf);
+        self.compiled.unpack(&buf, out);
+    }
+}
+
+/// The objective value that means "target met" for the compiled objective (squared
+/// distance for one target, Eq. 38 otherwise).
+pub fn objective_target(model: &Model) -> f64 {
+    if model.targets.len() == 1 {
+        let w = model.targets[0].weight;
+        (model.threshold / w).powi(2) * w * w
+    } else {
+        model.threshold
+    }
+}
+
+/// f64 evaluation of the same outputs (the plain kinematics, no symbols).
+pub fn outputs_f64(model: &Model, free: &[f64], modes: &[f64]) -> (f64, Vec<f64>) {
+    let vars = model.full_vars(free);
+    let times: Vec<f64> = model.times.clone();
+    let out = model.outputs(&vars, modes, &times);
+    (out.objective, out.constraints)
+}

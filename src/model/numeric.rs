@@ -1,0 +1,84 @@
+//! The numeric path: a model evaluated in `f64` for given variables and modes, turned into
+//! a [`Pattern`] (flat layout, creases, facets, folded frames) for verification, checks
+//! and export.
+
+use super::geometry::{self, Flat, Folded};
+use super::plan::Plan;
+use crate::kinematics::wrap_angle;
+use crate::pattern::{Edge, EdgeKind, Frame, Pattern};
+
+/// A design evaluated numerically: the flat pattern and any number of folded states.
+#[derive(Clone, Debug)]
+pub struct Evaluated<'a> {
+    /// The plan it belongs to.
+    pub plan: &'a Plan,
+    /// The full variable vector.
+    pub vars: Vec<f64>,
+    /// ±1 per internal vertex.
+    pub modes: Vec<f64>,
+    /// The flat pattern.
+    pub flat: Flat<f64>,
+}
+
+impl<'a> Evaluated<'a> {
+    /// Evaluate `plan` at `vars` (full vector) with `modes`.
+    pub fn new(plan: &'a Plan, vars: Vec<f64>, modes: Vec<f64>) -> Evaluated<'a> {
+        let flat = geometry::flat(plan, &vars);
+        Evaluated { plan, vars, modes, flat }
+    }
+
+    /// The folded state at `t`.
+    pub fn fold(&self, t: f64) -> Folded<f64> {
+        geometry::fold(self.plan, &self.flat, &self.modes, &t)
+    }
+
+    /// 3D position of every vertex at the folded state `folded`.
+    pub fn coords(&self, folded: &Folded<f64>) -> Vec<[f64; 3]> {
+        (0..self.plan.vertices.len()).map(|v| geometry::position(self.plan, &self.flat, folded, v)).collect()
+    }
+
+    /// The edges of the pattern: every crease (tail first), then the paper's edges that
+    /// close open facets.
+    pub fn edges(&self) -> Vec<Edge> {
+        let mut edges: Vec<Edge> = self
+            .plan
+            .creases
+            .iter()
+            .map(|c| Edge { v: [c.tail, c.head], kind: EdgeKind::Crease { driven: c.drive.is_some() } })
+            .collect();
+        for (poly, closed) in &self.plan.polygons {
+            if !closed && poly.len() >= 2 {
+                edges.push(Edge { v: [poly[poly.len() - 1], poly[0]], kind: EdgeKind::Boundary });
+            }
+        }
+        edges
+    }
+
+    /// The pattern with frames at the given values of t.
+    pub fn pattern(&self, ts: &[f64]) -> Pattern {
+        let edges = self.edges();
+        let ncreases = self.plan.creases.len();
+        let frames = ts
+            .iter()
+            .map(|&t| {
+                let folded = self.fold(t);
+                let mut fold_angles: Vec<f64> = folded.rho.iter().map(|r| wrap_angle(*r)).collect();
+                fold_angles.resize(edges.len(), 0.0);
+                debug_assert!(fold_angles.len() >= ncreases);
+                Frame { t, coords: self.coords(&folded), fold_angles }
+            })
+            .collect();
+        Pattern {
+            vertices: self.flat.pos.clone(),
+            edges,
+            faces: self.plan.polygons.iter().filter(|(p, _)| p.len() >= 3).map(|(p, _)| p.clone()).collect(),
+            frames,
+        }
+    }
+}
+
+/// `n` evenly spaced values over `[0, t_max]` (both ends included, `n ≥ 2`).
+pub fn sample_times(t_max: f64, n: usize) -> Vec<f64> {
+    let n = n.max(2);
+    (0..n).map(|i| t_max * i as f64 / (n - 1) as f64).collect()
+}

@@ -1,0 +1,56 @@
+//! PNG and GIF output decode to the requested size, and the animation shows the motion.
+
+use foldsynth::export::render::{Camera, Scene};
+use foldsynth::export::{DesignMeta, picked_frames, samples};
+
+#[test]
+fn picked_frames_are_even_and_keep_the_ends() {
+    assert_eq!(picked_frames(9, 4), vec![0, 3, 5, 8]);
+    assert_eq!(picked_frames(3, 10), vec![0, 1, 2]);
+    assert_eq!(picked_frames(5, 1), vec![4]);
+    assert!(picked_frames(0, 3).is_empty());
+    let p = picked_frames(1000, 60);
+    assert_eq!((p.len(), p[0], p[59]), (60, 0, 999));
+    assert!(p.windows(2).all(|w| w[0] < w[1]));
+}
+
+#[test]
+fn png_decodes_to_the_requested_size() {
+    let p = samples::degree4(1.2, 1.5, 3);
+    let meta = DesignMeta::default();
+    let scene = Scene::new(&p, &meta, Camera::default()).unwrap();
+    let png = scene.png(Some(2), (321, 123)).unwrap();
+    let img = tiny_skia::Pixmap::decode_png(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (321, 123));
+    assert!(
+        scene
+            .png(Some(2), (8, 8))
+            .unwrap_err()
+            .to_string()
+            .contains("16..=4096")
+    );
+}
+
+#[test]
+fn gif_has_the_picked_frames_and_they_move() {
+    let p = samples::single_crease(3.0, 100);
+    let meta = DesignMeta {
+        second_arm: true,
+        ..DesignMeta::default()
+    };
+    let scene = Scene::new(&p, &meta, Camera::default()).unwrap();
+    let bytes = scene.gif((120, 90), 4, 12).unwrap();
+    let mut opts = gif::DecodeOptions::new();
+    opts.set_color_output(gif::ColorOutput::RGBA);
+    let mut dec = opts.read_info(bytes.as_slice()).unwrap();
+    assert_eq!((dec.width(), dec.height()), (120, 90));
+    let mut frames = Vec::new();
+    while let Some(f) = dec.read_next_frame().unwrap() {
+        frames.push((f.delay, f.buffer.to_vec()));
+    }
+    assert_eq!(frames.len(), 12);
+    // The sheet moves: first and last pictures differ; the last frame lingers.
+    assert_ne!(frames[0].1, frames[11].1);
+    assert_eq!(frames[0].0, 4);
+    assert!(frames[11].0 > 4);
+}

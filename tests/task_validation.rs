@@ -1,0 +1,444 @@
+//! Task files: the thesis's two tasks load with their data; every kind of bad input gets a
+//! clear error naming the file, the field and what is allowed.
+
+use std::f64::consts::PI;
+
+use foldsynth::grammar::VertexType;
+use foldsynth::task::{Task, TaskError};
+
+fn path(name: &str) -> String {
+    format!("{}/grammar/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn the_gripper_task_carries_the_thesis_data() {
+    let t = Task::load(path("gripper.toml")).unwrap();
+    assert_eq!(t.name, "gripper");
+    assert_eq!(t.n_max, 3);
+    assert!(t.symmetry.mirror_xz);
+    let g0 = &t.initial;
+    assert_eq!(g0.vertices.len(), 2);
+    assert_eq!(
+        (g0.vertices[0].xy, g0.vertices[0].ty),
+        ([0.0, 0.0], VertexType::Terminal)
+    );
+    assert_eq!(
+        (g0.vertices[1].xy, g0.vertices[1].ty),
+        ([1.0, 0.0], VertexType::Extendable)
+    );
+    let c = &g0.creases[0];
+    assert_eq!((c.tail, c.head), (0, 1));
+    assert_eq!(
+        (g0.facets[c.left].as_str(), g0.facets[c.right].as_str()),
+        ("f1", "f2")
+    );
+    let drive = c.drive.as_ref().unwrap();
+    assert_eq!(drive.as_str(), "t");
+    assert_eq!(drive.eval(&0.7), 0.7);
+    assert_eq!(g0.vertices[1].preds, vec![0]);
+    assert_eq!(g0.vertices[1].slots, [None; 3]);
+    assert_eq!(g0.mirror.as_ref().unwrap().vertex, vec![0, 1]);
+    assert_eq!(g0.mirror.as_ref().unwrap().facet, vec![1, 0]);
+    assert_eq!(t.motion.unwrap().t_max, PI / 2.0);
+    let b = t.bounds.unwrap();
+    assert_eq!(
+        (b.l_min, b.l_max, b.alpha_min, b.alpha_max),
+        (0.1, 1.5, PI / 18.0, 17.0 * PI / 18.0)
+    );
+    let o = t.objective.as_ref().unwrap();
+    assert_eq!(o.threshold, 1e-5);
+    assert_eq!(o.targets.len(), 1);
+    assert_eq!(
+        (o.targets[0].t, o.targets[0].point, o.targets[0].weight),
+        (PI / 2.0, [0.0, 0.0, 1.0], 1.0)
+    );
+    let ch = t.check.as_ref().unwrap();
+    assert_eq!(ch.states, 16);
+    assert_eq!(ch.cylinders.len(), 1);
+    assert_eq!(
+        (
+            ch.cylinders[0].radius,
+            ch.cylinders[0].from,
+            ch.cylinders[0].to
+        ),
+        (0.25, [0.0, -1.0, 0.5], [0.0, 1.0, 0.5])
+    );
+}
+
+#[test]
+fn the_robotic_arm_task_carries_the_trajectory() {
+    let t = Task::load(path("robotic_arm.toml")).unwrap();
+    assert_eq!(t.initial, Task::load(path("gripper.toml")).unwrap().initial);
+    let o = t.objective.as_ref().unwrap();
+    assert_eq!(o.threshold, 0.3);
+    assert_eq!(o.targets.len(), 11);
+    for (i, tg) in o.targets.iter().enumerate() {
+        let ti = i as f64 * PI / 20.0;
+        assert!((tg.t - ti).abs() < 1e-15);
+        let p = [1.0 + 2.0 * ti.cos(), 0.0, 2.0 * ti.sin()];
+        for (a, b) in tg.point.iter().zip(p) {
+            assert!((a - b).abs() < 1e-15, "target {i}");
+        }
+    }
+    assert!(t.check.as_ref().unwrap().cylinders.is_empty());
+}
+
+const BASE: &str = r#"
+[grammar]
+n_max = 3
+[symmetry]
+mirror_xz = true
+[[initial_graph.vertices]]
+id = "v1"
+xy = [0.0, 0.0]
+type = "terminal"
+[[initial_graph.vertices]]
+id = "v2"
+xy = [1.0, 0.0]
+type = "extendable"
+[[initial_graph.creases]]
+from = "v1"
+to = "v2"
+left = "f1"
+right = "f2"
+drive = "t"
+"#;
+
+fn err(text: &str) -> TaskError {
+    match Task::from_toml_str(text, "bad.toml") {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e,
+    }
+}
+
+/// `BASE` with `from` replaced by `to` (which must occur).
+fn edit(from: &str, to: &str) -> String {
+    assert!(BASE.contains(from), "{from}");
+    BASE.replacen(from, to, 1)
+}
+
+fn assert_err(e: &TaskError, field: &str, words: &[&str]) {
+    assert_eq!(e.file, "bad.toml");
+    assert_eq!(e.field, field, "{e}");
+    for w in words {
+        assert!(e.message.contains(w), "`{w}` not in: {e}");
+    }
+    let shown = e.to_string();
+    assert!(shown.starts_with("bad.toml: ") && shown.contains(field));
+}
+
+#[test]
+fn the_base_case_is_valid() {
+    Task::from_toml_str(BASE, "ok.toml").unwrap();
+}
+
+#[test]
+fn a_cyclic_g0_is_rejected() {
+    let text = BASE.to_owned()
+        + "[[initial_graph.vertices]]\nid = \"v3\"\nxy = [1.0, 1.0]\ntype = \"extendable\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v2\"\nto = \"v3\"\nleft = \"f1\"\nright = \"f3\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v3\"\nto = \"v2\"\nleft = \"f3\"\nright = \"f1\"\n";
+    // v2 → v3 and v3 → v2 are one pair of vertices: caught as a double crease first.
+    assert_err(
+        &err(&text),
+        "initial_graph.creases[2]",
+        &["second crease between"],
+    );
+    let text = edit("drive = \"t\"\n", "drive = \"t\"\n")
+        + "[[initial_graph.vertices]]\nid = \"v3\"\nxy = [1.0, 1.0]\ntype = \"extendable\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v2\"\nto = \"v3\"\nleft = \"f1\"\nright = \"f3\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v3\"\nto = \"v1\"\nleft = \"f3\"\nright = \"f4\"\n";
+    let e = err(&text
+        .replace("type = \"terminal\"", "type = \"extendable\"")
+        .replace("drive = \"t\"\n", ""));
+    assert_err(&e, "initial_graph.creases", &["directed cycle", "acyclic"]);
+}
+
+#[test]
+fn a_vertex_with_three_successors_is_rejected() {
+    let mut text = BASE.to_owned();
+    for (id, x, y) in [("a", 2.0, 0.0), ("b", 1.0, 1.0), ("c", 1.0, -1.0)] {
+        text += &format!(
+            "[[initial_graph.vertices]]\nid = \"{id}\"\nxy = [{x}, {y}]\ntype = \"terminal\"\n"
+        );
+        text += &format!(
+            "[[initial_graph.creases]]\nfrom = \"v2\"\nto = \"{id}\"\nleft = \"g{id}\"\nright = \"h{id}\"\n"
+        );
+    }
+    assert_err(
+        &err(&text),
+        "initial_graph.vertices[1]",
+        &["already has 3 outgoing creases", "fewer than 3"],
+    );
+}
+
+#[test]
+fn inconsistent_facet_labels_are_rejected() {
+    // v2 → v3 shares no facet with v1 → v2: two open sectors around the extendable v2.
+    let text = BASE.to_owned()
+        + "[[initial_graph.vertices]]\nid = \"v3\"\nxy = [1.0, 1.0]\ntype = \"terminal\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v2\"\nto = \"v3\"\nleft = \"f3\"\nright = \"f4\"\n";
+    assert_err(
+        &err(&text),
+        "initial_graph.creases",
+        &["inconsistent facet labels", "open"],
+    );
+    // The same facet on both sides of a crease.
+    let e = err(&edit("right = \"f2\"", "right = \"f1\""));
+    assert_err(&e, "initial_graph.creases[0].right", &["different facets"]);
+    // A facet whose creases do not form one chain: f1 on two separate creases.
+    let text = BASE.replace("type = \"extendable\"", "type = \"terminal\"")
+        + "[[initial_graph.vertices]]\nid = \"v3\"\nxy = [0.0, 5.0]\ntype = \"terminal\"\n"
+        + "[[initial_graph.vertices]]\nid = \"v4\"\nxy = [1.0, 5.0]\ntype = \"terminal\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v3\"\nto = \"v4\"\nleft = \"f3\"\nright = \"f1\"\ndrive = \"t\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v1\"\nto = \"v3\"\nleft = \"f4\"\nright = \"f5\"\ndrive = \"t\"\n";
+    let e = err(&text.replace("mirror_xz = true", "mirror_xz = false"));
+    assert_err(
+        &e,
+        "initial_graph.creases",
+        &["inconsistent facet labels", "f1"],
+    );
+}
+
+#[test]
+fn a_disconnected_g0_is_rejected() {
+    let text = BASE.to_owned()
+        + "[[initial_graph.vertices]]\nid = \"v3\"\nxy = [5.0, 0.0]\ntype = \"terminal\"\n"
+        + "[[initial_graph.vertices]]\nid = \"v4\"\nxy = [6.0, 0.0]\ntype = \"terminal\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v3\"\nto = \"v4\"\nleft = \"f3\"\nright = \"f4\"\ndrive = \"t\"\n";
+    assert_err(&err(&text), "initial_graph", &["disconnected", "\"v3\""]);
+}
+
+#[test]
+fn duplicate_and_unknown_ids_are_rejected() {
+    let e = err(&edit("id = \"v2\"", "id = \"v1\""));
+    assert_err(
+        &e,
+        "initial_graph.vertices[1].id",
+        &["duplicate id \"v1\"", "unique"],
+    );
+    let e = err(&edit("to = \"v2\"", "to = \"v9\""));
+    assert_err(
+        &e,
+        "initial_graph.creases[0].to",
+        &["unknown vertex \"v9\"", "v1, v2"],
+    );
+    let e = err(&edit("to = \"v2\"", "to = \"v1\""));
+    assert_err(&e, "initial_graph.creases[0].to", &["to itself"]);
+}
+
+#[test]
+fn unknown_fields_are_rejected() {
+    let e = err(&edit("n_max = 3", "n_max = 3\nnmax = 4"));
+    assert_eq!(e.file, "bad.toml");
+    assert!(e.field.contains("nmax"), "{e}");
+    assert!(
+        e.message.contains("unknown field") && e.message.contains("n_max"),
+        "{e}"
+    );
+    assert!(e.message.contains("line 4"), "{e}");
+    let e = err(&edit(
+        "type = \"terminal\"",
+        "type = \"terminal\"\ncolour = \"red\"",
+    ));
+    assert!(
+        e.field.contains("colour") && e.message.contains("unknown field"),
+        "{e}"
+    );
+    let e = err(&edit("type = \"terminal\"", "type = \"source\""));
+    assert!(
+        e.message.contains("extendable") && e.message.contains("terminal"),
+        "{e}"
+    );
+}
+
+#[test]
+fn bad_coordinates_are_rejected() {
+    let e = err(&edit("xy = [1.0, 0.0]", "xy = [nan, 0.0]"));
+    assert_err(
+        &e,
+        "initial_graph.vertices[1].xy[0]",
+        &["not a finite number"],
+    );
+    let e = err(&edit("xy = [1.0, 0.0]", "xy = [1.0, inf]"));
+    assert_err(
+        &e,
+        "initial_graph.vertices[1].xy[1]",
+        &["not a finite number"],
+    );
+    let e = err(&edit("xy = [1.0, 0.0]", "xy = [0.0, 0.0]"));
+    assert_err(
+        &e,
+        "initial_graph.vertices[1].xy",
+        &["lies on vertex \"v1\""],
+    );
+    let e = err(&edit("xy = [1.0, 0.0]", "xy = [\"1/0\", 0.0]"));
+    assert_err(
+        &e,
+        "initial_graph.vertices[1].xy[0]",
+        &["not a finite number"],
+    );
+    let e = err(&edit("xy = [1.0, 0.0]", "xy = [\"one\", 0.0]"));
+    assert_err(
+        &e,
+        "initial_graph.vertices[1].xy[0]",
+        &["unknown name `one`"],
+    );
+}
+
+#[test]
+fn drives_are_checked() {
+    let e = err(&edit("drive = \"t\"\n", ""));
+    assert_err(
+        &e,
+        "initial_graph.creases[0].drive",
+        &["driven", "needs a driving angle"],
+    );
+    let e = err(&edit("drive = \"t\"", "drive = \"t +\""));
+    assert_err(
+        &e,
+        "initial_graph.creases[0].drive",
+        &["not a driving-angle expression"],
+    );
+    let e = err(&edit("drive = \"t\"", "drive = \"pi/2\""));
+    assert_err(
+        &e,
+        "initial_graph.creases[0].drive",
+        &["does not use the driving parameter"],
+    );
+    let text = BASE.to_owned()
+        + "[[initial_graph.vertices]]\nid = \"v3\"\nxy = [1.0, -1.0]\ntype = \"terminal\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v2\"\nto = \"v3\"\nleft = \"f3\"\nright = \"f2\"\ndrive = \"t\"\n";
+    assert_err(
+        &err(&text),
+        "initial_graph.creases[1].drive",
+        &["takes no drive"],
+    );
+    let t = Task::from_toml_str(&edit("drive = \"t\"", "drive = \"-t/1.2\""), "ok.toml").unwrap();
+    assert_eq!(
+        t.initial.creases[0].drive.as_ref().unwrap().eval(&1.2),
+        -1.0
+    );
+}
+
+#[test]
+fn types_and_structure_of_extendable_vertices_are_checked() {
+    let e = err(&edit("type = \"terminal\"", "type = \"extendable\""));
+    assert_err(
+        &e,
+        "initial_graph.vertices[0].type",
+        &["no incoming crease", "terminal"],
+    );
+    // A lone outgoing crease in the middle of the open sector (no facet shared with p1 or
+    // pm) is none of the scenarios of Tables 1–2.
+    let text = BASE.to_owned()
+        + "[[initial_graph.vertices]]\nid = \"v3\"\nxy = [2.0, 0.0]\ntype = \"terminal\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v2\"\nto = \"v3\"\nleft = \"f3\"\nright = \"f4\"\n";
+    assert_err(
+        &err(&text),
+        "initial_graph.creases",
+        &["2 sectors are open", "exactly one open sector"],
+    );
+    let e = err(&edit("n_max = 3", "n_max = 99"));
+    assert_err(&e, "grammar.n_max", &["allowed 0..="]);
+    let e = err(&edit("n_max = 3", "n_max = -1"));
+    assert_err(&e, "grammar.n_max", &["allowed 0..="]);
+}
+
+#[test]
+fn mirror_symmetry_of_g0_is_checked() {
+    let text = BASE.to_owned()
+        + "[[initial_graph.vertices]]\nid = \"v3\"\nxy = [1.0, -1.0]\ntype = \"terminal\"\n"
+        + "[[initial_graph.creases]]\nfrom = \"v2\"\nto = \"v3\"\nleft = \"f3\"\nright = \"f2\"\n";
+    assert_err(
+        &err(&text),
+        "symmetry.mirror_xz",
+        &["not symmetric", "(1, 1)"],
+    );
+    Task::from_toml_str(
+        &text.replace("mirror_xz = true", "mirror_xz = false"),
+        "ok.toml",
+    )
+    .unwrap();
+}
+
+#[test]
+fn design_fields_are_checked() {
+    let with = |extra: &str| BASE.to_owned() + extra;
+    let e = err(&with("[motion]\nt_max = 4\n"));
+    assert_err(&e, "motion.t_max", &["within [-pi, pi]"]);
+    let e = err(&with("[motion]\nt_max = 0\n"));
+    assert_err(&e, "motion.t_max", &["nonzero"]);
+    let b = |l_min: &str, l_max: &str, a_min: &str, a_max: &str| {
+        with(&format!(
+            "[bounds]\nl_min = {l_min}\nl_max = {l_max}\nalpha_min = {a_min}\nalpha_max = {a_max}\n"
+        ))
+    };
+    assert_err(&err(&b("0", "1.5", "0.1", "3")), "bounds.l_min", &["> 0"]);
+    assert_err(
+        &err(&b("0.1", "0.1", "0.1", "3")),
+        "bounds.l_max",
+        &["exceed l_min"],
+    );
+    assert_err(
+        &err(&b("0.1", "1.5", "0", "3")),
+        "bounds.alpha_min",
+        &["(0, pi)"],
+    );
+    assert_err(
+        &err(&b("0.1", "1.5", "0.1", "\"pi\"")),
+        "bounds.alpha_max",
+        &["(alpha_min"],
+    );
+    let e = err(&with(
+        "[bounds]\nl_min = 0.1\nl_max = 1.5\nalpha_min = 0.1\n",
+    ));
+    assert!(e.message.contains("missing field `alpha_max`"), "{e}");
+    let obj = |t: &str, extra: &str| {
+        with(&format!(
+            "[motion]\nt_max = \"pi/2\"\n[objective]\nthreshold = 1e-5\n[[objective.targets]]\nt = {t}\npoint = [0, 0, 1]\n{extra}"
+        ))
+    };
+    assert_err(
+        &err(&obj("2", "")),
+        "objective.targets[0].t",
+        &["outside the motion range"],
+    );
+    assert_err(
+        &err(&obj("1", "weight = -1\n")),
+        "objective.targets[0].weight",
+        &["> 0"],
+    );
+    Task::from_toml_str(&obj("\"pi/4\"", "weight = 2\n"), "ok.toml").unwrap();
+    let e = err(&with(
+        "[objective]\nthreshold = 1\n[[objective.targets]]\nt = 1\npoint = [0, 0, 1]\n",
+    ));
+    assert_err(&e, "objective", &["needs the motion range"]);
+    let e = err(&with(
+        "[motion]\nt_max = 1\n[objective]\nthreshold = 1\ntargets = []\n",
+    ));
+    assert_err(&e, "objective.targets", &["at least one"]);
+    let e = err(&with("[check]\nstates = 1\n"));
+    assert_err(&e, "check.states", &["at least 2"]);
+    let e = err(&with(
+        "[check]\nstates = 16\n[[check.cylinders]]\nradius = 0.25\nfrom = [0, 0, 0]\nto = [0, 0, 0]\n",
+    ));
+    assert_err(&e, "check.cylinders[0].to", &["distinct"]);
+    let e = err(&with(
+        "[check]\nstates = 16\n[[check.cylinders]]\nradius = -1\nfrom = [0, 0, 0]\nto = [0, 1, 0]\n",
+    ));
+    assert_err(&e, "check.cylinders[0].radius", &["> 0"]);
+}
+
+#[test]
+fn unreadable_files_and_syntax_errors_are_reported() {
+    let e = Task::load("/nonexistent/task.toml").unwrap_err();
+    assert_eq!(e.file, "/nonexistent/task.toml");
+    assert!(e.message.contains("cannot read"), "{e}");
+    let e = err("[grammar\nn_max = 3\n");
+    assert!(e.message.contains("line 1"), "{e}");
+    let e = err("[grammar]\nn_max = 3\n");
+    assert!(e.message.contains("missing field `initial_graph`"), "{e}");
+    let e = err(&edit("n_max = 3", "n_max = \"three\""));
+    assert!(e.message.contains("line 3"), "{e}");
+}
