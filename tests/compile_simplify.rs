@@ -156,6 +156,7 @@ fn compile_without_simplification_is_exactly_the_interpreter() {
         &Options {
             simplify: None,
             gradients: false,
+            ..Options::default()
         },
     )
     .unwrap();

@@ -2,8 +2,10 @@
 """CasADi peer for `foldsynth bench vertex --peer casadi`.
 
 Builds the same function as foldsynth -- phi1 + phi2 + phi3 of one vertex by the PTU,
-written exactly as foldsynth's kinematics writes it (src/kinematics/ptu.rs: atan2 forms
-of U, beta, delta; the half-angle form of the internal angles; max0(x) = (x + x*sgn x)/2)
+written exactly as foldsynth's kinematics writes it (src/kinematics/ptu.rs: the unit's
+rotation chain as one 3x3 product whose first column and first row give P_jm and P'_j0;
+atan2 forms of U, beta, delta; the half-angle form of the internal angles;
+max0(x) = (x + x*sgn x)/2)
 -- in CasADi SX, takes its reverse-mode gradient, generates C, compiles it with
 `gcc -O3`, and times value+gradient in a C harness (batches, median).
 
@@ -48,30 +50,32 @@ def ptu_phi_sum(ca, sectors, driving, mode):
     """sectors: per unit a list of SX; driving: per unit a list of SX; mode: SX."""
     sin, cos, atan2, sqrt, sign = ca.sin, ca.cos, ca.atan2, ca.sqrt, ca.sign
 
-    def rot_x(v, c, s):
-        x, y, z = v
-        return [x, y * c - z * s, y * s + z * c]
-
-    def rot_z(v, c, s):
-        x, y, z = v
-        return [x * c - y * s, x * s + y * c, z]
+    def chain(sec, drv):
+        # Q = R_z(a1) R_x(r1) ... R_x(r_{m-1}) R_z(a_m) as rows (src/kinematics/ptu.rs):
+        # its first column is P_jm (Eq. 17), its first row P'_j0 (Eq. 21).
+        m = len(sec)
+        c, s = cos(sec[-1]), sin(sec[-1])
+        q = [[c, -s, 0], [s, c, 0], [0, 0, 1]]
+        for i in reversed(range(m - 1)):
+            c, s = cos(drv[i]), sin(drv[i])
+            r0, r1, r2 = q
+            r1x = [c * r1[k] - s * r2[k] for k in range(3)]
+            r2x = [s * r1[k] + c * r2[k] for k in range(3)]
+            c, s = cos(sec[i]), sin(sec[i])
+            r0z = [c * r0[k] - s * r1x[k] for k in range(3)]
+            r1z = [s * r0[k] + c * r1x[k] for k in range(3)]
+            q = [r0z, r1z, r2x]
+        return q
 
     def unit_angles(sec, drv):
-        m = len(sec)
-        if m == 1:
+        if len(sec) == 1:
             return sec[0], 0, 0
-        v = [cos(sec[-1]), sin(sec[-1]), 0]
-        for i in reversed(range(m - 1)):
-            v = rot_x(v, cos(drv[i]), sin(drv[i]))
-            v = rot_z(v, cos(sec[i]), sin(sec[i]))
-        x, y, z = v
+        q = chain(sec, drv)
+        x, r01, r02 = q[0]
+        y, z = q[1][0], q[2][0]
         u = atan2(sqrt(y * y + z * z), x)
         beta = -atan2(z, y)
-        w = [cos(sec[0]), -sin(sec[0]), 0]
-        for i in range(m - 1):
-            w = rot_x(w, cos(drv[i]), -sin(drv[i]))
-            w = rot_z(w, cos(sec[i + 1]), -sin(sec[i + 1]))
-        delta = -atan2(w[2], -w[1])
+        delta = -atan2(r02, -r01)
         return u, beta, delta
 
     def max0(x):

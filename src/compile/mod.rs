@@ -34,7 +34,7 @@ pub mod vertex;
 
 pub use diff::{gradient, gradients};
 pub use dual::Dual;
-pub use jit::{CompileError, CompiledFn};
+pub use jit::{CompileError, CompiledFn, OptLevel};
 
 use crate::expr::{Counts, ExprGraph, NodeId, check_indices};
 use std::time::Instant;
@@ -46,6 +46,8 @@ pub struct Options {
     pub simplify: Option<simplify::Limits>,
     /// Append the gradient of every output with respect to all variables.
     pub gradients: bool,
+    /// Cranelift's optimization level.
+    pub opt_level: OptLevel,
 }
 
 impl Default for Options {
@@ -53,6 +55,7 @@ impl Default for Options {
         Options {
             simplify: Some(simplify::Limits::default()),
             gradients: true,
+            opt_level: OptLevel::Auto,
         }
     }
 }
@@ -161,7 +164,7 @@ pub fn compile(
     let diff_ms = t1.elapsed().as_secs_f64() * 1e3;
     let with_gradients = g.counts(&all);
     let t2 = Instant::now();
-    let function = CompiledFn::new(&g, &all, n_vars, n_params)?;
+    let function = CompiledFn::with_opt_level(&g, &all, n_vars, n_params, opts.opt_level)?;
     let jit_ms = t2.elapsed().as_secs_f64() * 1e3;
     Ok(Compiled {
         function,

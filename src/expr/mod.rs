@@ -21,7 +21,7 @@
 //! - [`ExprGraph`]: the arena; [`ExprGraph::add`] hash-conses and folds.
 //! - [`Ctx`] / [`Sym`]: a shared graph and the handle implementing `Scalar`.
 //! - [`Tape`]: the interpreter.
-//! - [`print`]: printers (plain, LaTeX, Mathematica, Python, DOT).
+//! - [`print`](mod@print): printers (plain, LaTeX, Mathematica, Python, DOT).
 
 mod eval;
 mod graph;
@@ -33,6 +33,6 @@ pub(crate) use eval::check_indices;
 pub use eval::{ShapeError, Tape};
 pub(crate) use graph::FxHashMap;
 pub use graph::{Counts, ExprGraph};
-pub use node::{Children, Node, NodeId, Range, clamp_unit, select};
+pub use node::{Children, INPUT_BOUND, Node, NodeId, Range, clamp_unit, select};
 pub use print::{Format, Names};
 pub use sym::{Ctx, Sym};
