@@ -1,7 +1,7 @@
 use foldsynth::compile::Options;
 use foldsynth::grammar::{Enumeration, Filters};
-use foldsynth::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use foldsynth::model::Model;
+use foldsynth::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use foldsynth::optimize;
 use foldsynth::task::Task;
 use std::time::Instant;
@@ -24,15 +24,32 @@ fn main() {
         let compiled = CompiledModel::new(&model, &Options::default()).unwrap();
         let n = model.plan.internal.len();
         for bits in [0u32, (1 << n) - 1] {
-            let modes: Vec<f64> = (0..n).map(|i| if bits >> i & 1 == 1 { -1.0 } else { 1.0 }).collect();
+            let modes: Vec<f64> = (0..n)
+                .map(|i| if bits >> i & 1 == 1 { -1.0 } else { 1.0 })
+                .collect();
             let p = ModelProblem::new(&model, &compiled, &modes);
-            let sol = optimize::minimize(&p, &optimize::Options { starts, seed: gi as u64, max_outer, max_inner, target: Some(objective_target(&model)), ..Default::default() });
+            let sol = optimize::minimize(
+                &p,
+                &optimize::Options {
+                    starts,
+                    seed: gi as u64,
+                    max_outer,
+                    max_inner,
+                    target: Some(objective_target(&model)),
+                    ..Default::default()
+                },
+            );
             let full = model.full_vars(&sol.x);
             let omega = model.omega(&full, &modes);
             total += 1;
             evals += sol.evaluations;
-            if sol.feasible && omega <= model.threshold { meets += 1; }
+            if sol.feasible && omega <= model.threshold {
+                meets += 1;
+            }
         }
     }
-    println!("outer {max_outer} inner {max_inner} starts {starts}: {meets}/{total} meet, {evals} evals, {:.2} s", t0.elapsed().as_secs_f64());
+    println!(
+        "outer {max_outer} inner {max_inner} starts {starts}: {meets}/{total} meet, {evals} evals, {:.2} s",
+        t0.elapsed().as_secs_f64()
+    );
 }

@@ -7,11 +7,11 @@ pub mod enumerate;
 pub mod export;
 pub mod formulas;
 pub mod model;
+pub mod optimize_flasher;
+pub mod simulate;
 pub mod synthesize;
 pub mod verify;
 pub mod vertex;
-pub mod optimize_flasher;
-pub mod simulate;
 
 /// foldsynth: synthesize rigidly foldable origami crease patterns.
 #[derive(Debug, Parser)]

@@ -201,16 +201,17 @@ pub fn run(args: ModelArgs) -> Result<()> {
         for (k, o) in outputs[1..].iter().enumerate() {
             named.push((format!("g{}", k + 1), ctx.node_id(o)));
         }
-        let mut names = Names::default();
-        names.vars = model
-            .free
-            .iter()
-            .map(|&i| ascii_name(&model.plan.variables[i].name))
-            .collect();
-        names.params = (0..n).map(|k| format!("M{}", k + 1)).collect();
-        names
-            .params
-            .extend((0..model.times.len()).map(|k| format!("t{k}")));
+        let names = Names {
+            vars: model
+                .free
+                .iter()
+                .map(|&i| ascii_name(&model.plan.variables[i].name))
+                .collect(),
+            params: (0..n)
+                .map(|k| format!("M{}", k + 1))
+                .chain((0..model.times.len()).map(|k| format!("t{k}")))
+                .collect(),
+        };
         println!("{}", print(&ctx.graph(), &named, &names, format));
         return Ok(());
     }

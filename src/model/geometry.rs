@@ -48,17 +48,17 @@ fn direction_angle<S: Scalar>(
 ) -> S {
     if let (Position::Placed { parent, crease, .. }, Some(a)) =
         (&plan.vertices[to].position, &ang[to])
+        && *parent == from
+        && plan.creases[*crease].head == to
     {
-        if *parent == from && plan.creases[*crease].head == to {
-            return a.clone();
-        }
+        return a.clone();
     }
     if let (Position::Placed { parent, crease, .. }, Some(a)) =
         (&plan.vertices[from].position, &ang[from])
+        && *parent == to
+        && plan.creases[*crease].head == from
     {
-        if *parent == to && plan.creases[*crease].head == from {
-            return a.clone() + PI;
-        }
+        return a.clone() + PI;
     }
     if let (Position::Fixed(p), Position::Fixed(q)) =
         (&plan.vertices[from].position, &plan.vertices[to].position)

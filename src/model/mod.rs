@@ -148,7 +148,7 @@ impl Model {
         let gripping = candidates[candidate];
         let mut times = vec![t_max];
         for t in &targets {
-            if !times.iter().any(|s| *s == t.t) {
+            if !times.contains(&t.t) {
                 times.push(t.t);
             }
         }

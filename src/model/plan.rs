@@ -391,13 +391,13 @@ impl Builder {
                 }
             }
         }
-        if let Some(f) = known.iter().position(|k| !k) {
-            if polygons[f].0.len() >= 2 {
-                return Err(PlanError(format!(
-                    "facet {} cannot be placed: none of its creases has a known dihedral angle",
-                    graph.facet_name(crate::grammar::FacetId(f as u32))
-                )));
-            }
+        if let Some(f) = known.iter().position(|k| !k)
+            && polygons[f].0.len() >= 2
+        {
+            return Err(PlanError(format!(
+                "facet {} cannot be placed: none of its creases has a known dihedral angle",
+                graph.facet_name(crate::grammar::FacetId(f as u32))
+            )));
         }
         let mut home_facet = vec![usize::MAX; vertices.len()];
         for (f, (poly, _)) in polygons.iter().enumerate() {
@@ -542,22 +542,19 @@ fn recipe(
     v: usize,
     ray: &Ray,
 ) -> (usize, Vec<(f64, usize)>) {
-    if ray.outgoing {
-        let c = &creases[ray.crease];
-        if let Some((_, true)) = c.length {
-            if let Position::Placed {
-                parent,
-                reference,
-                sign,
-                sectors,
-                ..
-            } = &vertices[c.head].position
-            {
-                if *parent == v {
-                    return (*reference, sectors.iter().map(|s| (*sign, *s)).collect());
-                }
-            }
-        }
+    let c = &creases[ray.crease];
+    if ray.outgoing
+        && let Some((_, true)) = c.length
+        && let Position::Placed {
+            parent,
+            reference,
+            sign,
+            sectors,
+            ..
+        } = &vertices[c.head].position
+        && *parent == v
+    {
+        return (*reference, sectors.iter().map(|s| (*sign, *s)).collect());
     }
     (ray.other, Vec::new())
 }

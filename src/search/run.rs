@@ -143,6 +143,9 @@ pub struct Prepared {
     pub compiled: CompiledModel,
 }
 
+/// A lazily compiled model (or why it failed) and the seconds it took.
+type CompiledSlot = (Result<Arc<Prepared>, String>, f64);
+
 /// Build and compile the model of one graph and candidate.
 pub fn prepare(graph: &CreaseGraph, task: &Task, candidate: usize) -> Result<Prepared, String> {
     let model = Model::new(graph, task, candidate).map_err(|e| e.to_string())?;
@@ -417,7 +420,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
             .map_err(io(&jsonl))?,
     );
 
-    let cache: Vec<OnceLock<(Result<Arc<Prepared>, String>, f64)>> =
+    let cache: Vec<OnceLock<CompiledSlot>> =
         (0..graphs.len() * 3).map(|_| OnceLock::new()).collect();
     let bar = if opts.progress && std::io::stderr().is_terminal() {
         let b =
