@@ -50,7 +50,7 @@ impl Default for SearchOptions {
         SearchOptions {
             out: PathBuf::from("out"),
             jobs: 0,
-            starts: 24,
+            starts: 16,
             seed: 0,
             resume: false,
             n_max: None,
