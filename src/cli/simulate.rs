@@ -1,51 +1,144 @@
 //! `foldsynth simulate FILE [--steps J] [--json]`: the bar-and-hinge simulation of a
-//! pattern file, with a table of δ(j), Γ, θ and the verdict.
+//! pattern file, a FOLD file or a design JSON, with a table of δ(j), Γ, θ and the verdict;
+//! `foldsynth simulate --crossval DIR`: every design of a synthesis run simulated and
+//! compared with the PTU.
+//!
+//! FILE is read by its extension: `.toml` is a pattern file (`grammar/*.toml`, drives in
+//! the file); `.fold` a FOLD file and `.json` a design (`designs/<id>.json`, or any
+//! `{"pattern": …}`). Those two are driven like the design tasks (SPEC §4, see
+//! [`crate::simulate::crossval`]): the crease marked driven (`edges_foldsynth:driven`,
+//! or `--driven`) is folded to ρ(t) mirror-symmetrically, with ρ read from the frames (or
+//! `--angle`); their frames are the PTU's motion, so every simulated state that has a
+//! frame is compared with it.
 
 use std::fmt::Write as _;
 use std::io::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
 
-use anyhow::Context;
+use anyhow::{Context, bail};
 use clap::Args;
+use serde_json::json;
 
-use crate::simulate::{PatternFile, RIGID_DELTA, SimReport, simulate};
+use crate::export::fold::FoldFile;
+use crate::pattern::Pattern;
+use crate::simulate::crossval::{
+    self, CrossvalOptions, CrossvalReport, G0Drive, GAMMA_TOL, POSITION_TOL,
+};
+use crate::simulate::{Formula, PatternFile, RIGID_DELTA, SimReport, simulate};
 
 /// Arguments of `foldsynth simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
-    /// A pattern file (TOML, see `grammar/flasher_adapted.toml`).
-    pub file: PathBuf,
-    /// Number of folding steps J (overrides the file's `motion.steps`).
+    /// A pattern file (.toml, see `grammar/flasher_adapted.toml`), a FOLD file (.fold) or a
+    /// design JSON (.json, e.g. `OUT/designs/<id>.json` of `foldsynth synthesize`).
+    #[arg(required_unless_present = "crossval")]
+    pub file: Option<PathBuf>,
+    /// Cross-validate every design of DIR (a `foldsynth synthesize` output directory, or
+    /// a directory of design JSON files) against the PTU; fails unless all agree.
+    #[arg(long, value_name = "DIR", conflicts_with = "file")]
+    pub crossval: Option<PathBuf>,
+    /// Number of folding steps J (default: the file's `motion.steps`; for FOLD/design files
+    /// one step per frame after the first, or 30 without frames).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
     pub steps: Option<u64>,
+    /// FOLD/design: the driven crease (0-based edge index; default: the edge marked
+    /// driven).
+    #[arg(long, value_name = "EDGE")]
+    pub driven: Option<usize>,
+    /// FOLD/design: the driven crease's fold angle as a formula in t, valley positive,
+    /// 0 at the start (default: read from the frames; "t" without frames).
+    #[arg(long, value_name = "FORMULA", allow_hyphen_values = true)]
+    pub angle: Option<String>,
+    /// FOLD/design: end of the motion, a number or a formula without t (default: the
+    /// last frame's t).
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    pub t_max: Option<String>,
+    /// FOLD/design: skip the self-intersection check (θ is then reported as 0).
+    #[arg(long)]
+    pub no_intersections: bool,
+    /// FOLD/design: Eq. 2's bars only, without the rigid-panel apexes on facets with more
+    /// than three corners (those then bend at second order; see
+    /// `simulate::crossval::add_panel_apexes`).
+    #[arg(long)]
+    pub eq2_bars: bool,
     /// Print the full report as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
 }
 
+/// What FILE is.
+enum Kind {
+    Toml,
+    Fold,
+    Design,
+}
+
+fn kind_of(path: &Path) -> Kind {
+    match path.extension().and_then(|e| e.to_str()).map(str::to_lowercase) {
+        Some(e) if e == "fold" => Kind::Fold,
+        Some(e) if e == "json" => Kind::Design,
+        _ => Kind::Toml,
+    }
+}
+
 /// Run `foldsynth simulate`.
 pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
-    let mut file = PatternFile::load(&args.file)?;
+    if let Some(dir) = &args.crossval {
+        return run_crossval(dir, &args);
+    }
+    let path = args
+        .file
+        .clone()
+        .context("give a FILE to simulate, or --crossval DIR")?;
+    match kind_of(&path) {
+        Kind::Toml => {
+            if args.driven.is_some() || args.angle.is_some() || args.t_max.is_some() {
+                bail!(
+                    "{}: --driven, --angle and --t-max are for FOLD and design files; a pattern file states its drives and motion itself",
+                    path.display()
+                );
+            }
+            run_toml(&path, &args)
+        }
+        Kind::Fold => {
+            let fold = FoldFile::read(&path)?;
+            let mut pattern = fold.to_pattern()?;
+            let note = if fold.frames.len() > 1 && fold.frames[1..].iter().any(|f| f.t.is_none())
+            {
+                // Without foldsynth:t the frames' t is unknown: they cannot be compared or
+                // give the angle, so the drive comes from the flags alone.
+                pattern.frames.clear();
+                Some("the file's frames have no foldsynth:t: they are not compared".to_string())
+            } else {
+                None
+            };
+            run_pattern(&path, &path.display().to_string(), &pattern, note, &args)
+        }
+        Kind::Design => {
+            let (name, pattern) = read_design(&path)?;
+            run_pattern(&path, &name, &pattern, None, &args)
+        }
+    }
+}
+
+fn run_toml(path: &Path, args: &SimulateArgs) -> anyhow::Result<()> {
+    let mut file = PatternFile::load(path)?;
     if let Some(j) = args.steps {
         file.input.steps = j as usize;
     }
-    let start = std::time::Instant::now();
+    let start = Instant::now();
     let report = simulate(&file.input).with_context(|| {
-        let legend: Vec<String> = file
-            .vertex_names
-            .iter()
-            .enumerate()
-            .map(|(i, n)| format!("{i}={n}"))
-            .collect();
         format!(
             "simulating {} (vertex numbers: {})",
-            args.file.display(),
-            legend.join(", ")
+            path.display(),
+            legend(&file.vertex_names)
         )
     })?;
     let seconds = start.elapsed().as_secs_f64();
     if args.json {
-        let out = serde_json::json!({
+        let out = json!({
             "name": file.name,
             "vertex_names": file.vertex_names,
             "steps": report.steps,
@@ -63,8 +156,367 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         });
         emit(&(serde_json::to_string_pretty(&out)? + "\n"))
     } else {
-        emit(&table(&file, &report, seconds))
+        let mut o = String::new();
+        let _ = writeln!(o, "{}", file.name);
+        let _ = writeln!(
+            o,
+            "{} vertices ({} free), {} facets, {} bars, J = {}",
+            file.vertex_names.len(),
+            report.free_vertices,
+            file.input.faces.len(),
+            report.bars,
+            report.steps.len()
+        );
+        steps_table(&mut o, &report, None);
+        summary(&mut o, &report);
+        positions(&mut o, &file.vertex_names, report.final_positions());
+        let _ = writeln!(o, "time                {seconds:.3} s");
+        emit(&o)
     }
+}
+
+fn legend(names: &[String]) -> String {
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| format!("{i}={n}"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// A design JSON: `{"pattern": <Pattern>, …}` (any other keys are ignored), or a bare
+/// Pattern. Returns a display name (`id`, else the file name) and the pattern.
+pub fn read_design(path: &Path) -> anyhow::Result<(String, Pattern)> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let v: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not valid JSON", path.display()))?;
+    let body = match v.get("pattern") {
+        Some(p) => p.clone(),
+        None if v.get("vertices").is_some() && v.get("faces").is_some() => v.clone(),
+        None => bail!(
+            "{}: not a design file: expected {{\"pattern\": {{vertices, edges, faces, frames}}, …}}",
+            path.display()
+        ),
+    };
+    let pattern: Pattern = serde_json::from_value(body).with_context(|| {
+        format!(
+            "{}: pattern: expected {{vertices, edges, faces, frames}} as foldsynth writes them",
+            path.display()
+        )
+    })?;
+    crate::export::validate_pattern(&pattern).with_context(|| format!("{}", path.display()))?;
+    for (k, f) in pattern.frames.iter().enumerate() {
+        if f.coords.len() != pattern.vertices.len() {
+            bail!(
+                "{}: pattern.frames[{k}].coords: {} positions for {} vertices",
+                path.display(),
+                f.coords.len(),
+                pattern.vertices.len()
+            );
+        }
+    }
+    let name = v
+        .get("id")
+        .and_then(|x| x.as_str())
+        .map(str::to_string)
+        .unwrap_or_else(|| path.display().to_string());
+    Ok((name, pattern))
+}
+
+/// The G0 drive for a FOLD/design pattern from the flags and the pattern.
+fn drive_for(pattern: &Pattern, args: &SimulateArgs) -> anyhow::Result<G0Drive> {
+    let edge = match args.driven {
+        Some(e) => e,
+        None => G0Drive::marked_edge(pattern)?,
+    };
+    if let Some(src) = &args.angle {
+        let f = Formula::parse(src).map_err(|e| anyhow::anyhow!("--angle: {e}"))?;
+        return Ok(G0Drive {
+            edge,
+            source: src.clone(),
+            angle: Arc::new(move |t| f.eval(t)),
+        });
+    }
+    if pattern.frames.is_empty() {
+        return Ok(G0Drive {
+            edge,
+            source: "t".into(),
+            angle: Arc::new(|t| t),
+        });
+    }
+    Ok(G0Drive::from_frames(pattern, edge)?)
+}
+
+fn parse_t_max(src: &str) -> anyhow::Result<f64> {
+    let f = Formula::parse(src).map_err(|e| anyhow::anyhow!("--t-max: {e}"))?;
+    let x = f.eval(f64::NAN);
+    if !x.is_finite() {
+        bail!("--t-max: must be a finite number or a formula without t (e.g. \"pi/2\")");
+    }
+    Ok(x)
+}
+
+fn run_pattern(
+    path: &Path,
+    name: &str,
+    pattern: &Pattern,
+    note: Option<String>,
+    args: &SimulateArgs,
+) -> anyhow::Result<()> {
+    let drive = drive_for(pattern, args).with_context(|| path.display().to_string())?;
+    let t_end = match &args.t_max {
+        Some(s) => Some(parse_t_max(s)?),
+        None if pattern.frames.len() < 2 => {
+            bail!(
+                "{}: the file has no folded frames to take the motion from: give its end with --t-max (e.g. --t-max \"pi/2\")",
+                path.display()
+            )
+        }
+        None => None,
+    };
+    let steps = match args.steps {
+        Some(j) => Some(j as usize),
+        None if pattern.frames.len() < 2 => Some(30),
+        None => None,
+    };
+    let opts = CrossvalOptions {
+        steps,
+        t_end,
+        check_intersections: !args.no_intersections,
+        rigid_panels: !args.eq2_bars,
+        ..Default::default()
+    };
+    let start = Instant::now();
+    let r = crossval::crossval(pattern, &drive, &opts)
+        .with_context(|| format!("simulating {}", path.display()))?;
+    let seconds = start.elapsed().as_secs_f64();
+    if args.json {
+        let mut out = serde_json::to_value(&r)?;
+        let extra = json!({
+            "name": name,
+            "note": note,
+            "steps_report": r.sim.steps,
+            "initial_intersections": r.sim.initial_intersections,
+            "final_positions": r.sim.final_positions(),
+            "sim_states": r.sim.states,
+            "rigid_delta_bound": RIGID_DELTA,
+            "gamma_tol": GAMMA_TOL,
+            "position_tol": POSITION_TOL,
+            "agrees_with_ptu": (r.compared_states > 0).then(|| r.agrees(GAMMA_TOL, POSITION_TOL)),
+            "seconds": seconds,
+        });
+        if let (Some(o), Some(e)) = (out.as_object_mut(), extra.as_object()) {
+            o.extend(e.clone());
+        }
+        return emit(&(serde_json::to_string_pretty(&out)? + "\n"));
+    }
+    let mut o = String::new();
+    let [p, q] = pattern.edges[drive.edge].v;
+    let _ = writeln!(o, "{name}");
+    let _ = writeln!(
+        o,
+        "{} vertices ({} free), {} facets, {} bars, J = {}; driven crease {} ({p}→{q}), ρ(t) = {}, t ∈ [{:.6}, {:.6}]",
+        pattern.vertices.len(),
+        r.free_vertices,
+        pattern.faces.len(),
+        r.bars,
+        r.steps,
+        drive.edge,
+        drive.source,
+        r.t_start,
+        r.t_end
+    );
+    if let Some(n) = &note {
+        let _ = writeln!(o, "note: {n}");
+    }
+    steps_table(&mut o, &r.sim, Some(&r));
+    summary(&mut o, &r.sim);
+    if r.compared_states > 0 {
+        let _ = writeln!(
+            o,
+            "vs the frames       max |x - X| {:.3e} over {} states; final {}; prescribed vertices {:.3e}",
+            r.max_position_error,
+            r.compared_states,
+            r.final_position_error
+                .map_or("not compared".into(), |e| format!("{e:.3e}")),
+            r.drive_error
+        );
+        let _ = writeln!(
+            o,
+            "agrees with the PTU {} (Γ <= {GAMMA_TOL:e}, |x - X| <= {POSITION_TOL:e})",
+            if r.agrees(GAMMA_TOL, POSITION_TOL) {
+                "yes"
+            } else {
+                "NO"
+            }
+        );
+    }
+    let names: Vec<String> = (0..pattern.vertices.len()).map(|i| i.to_string()).collect();
+    positions(&mut o, &names, r.sim.final_positions());
+    let _ = writeln!(o, "time                {seconds:.3} s");
+    emit(&o)
+}
+
+/// One design of a `--crossval` run.
+struct Row {
+    name: String,
+    vertices: usize,
+    result: Result<CrossvalReport, String>,
+}
+
+fn design_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    let sub = dir.join("designs");
+    let dir = if sub.is_dir() { sub } else { dir.to_path_buf() };
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .with_context(|| format!("{}: cannot read the directory", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        bail!(
+            "{}: no design JSON files (expected a `foldsynth synthesize` output directory or its designs/)",
+            dir.display()
+        );
+    }
+    Ok(files)
+}
+
+fn run_crossval(dir: &Path, args: &SimulateArgs) -> anyhow::Result<()> {
+    if args.angle.is_some() || args.t_max.is_some() || args.driven.is_some() {
+        bail!(
+            "--crossval drives every design by its marked crease over its frames; --driven, --angle and --t-max do not apply"
+        );
+    }
+    let files = design_files(dir)?;
+    let start = Instant::now();
+    let opts = CrossvalOptions {
+        steps: args.steps.map(|j| j as usize),
+        check_intersections: !args.no_intersections,
+        rigid_panels: !args.eq2_bars,
+        ..Default::default()
+    };
+    let rows: Vec<Row> = files
+        .iter()
+        .map(|path| match read_design(path) {
+            Err(e) => Row {
+                name: path.display().to_string(),
+                vertices: 0,
+                result: Err(format!("{e:#}")),
+            },
+            Ok((name, pattern)) => {
+                let result = G0Drive::marked_edge(&pattern)
+                    .and_then(|e| G0Drive::from_frames(&pattern, e))
+                    .and_then(|d| crossval::crossval(&pattern, &d, &opts))
+                    .map_err(|e| e.to_string());
+                Row {
+                    name,
+                    vertices: pattern.vertices.len(),
+                    result,
+                }
+            }
+        })
+        .collect();
+    let seconds = start.elapsed().as_secs_f64();
+    let ok: Vec<&CrossvalReport> = rows.iter().filter_map(|r| r.result.as_ref().ok()).collect();
+    let pass = |r: &CrossvalReport| r.agrees(GAMMA_TOL, POSITION_TOL);
+    let passed = ok.iter().filter(|r| pass(r)).count();
+    let max = |f: &dyn Fn(&CrossvalReport) -> f64| ok.iter().map(|r| f(r)).fold(0.0, f64::max);
+    let (max_gamma, max_delta, max_err, max_drive) = (
+        max(&|r| r.gamma),
+        max(&|r| r.max_delta),
+        max(&|r| r.max_position_error),
+        max(&|r| r.drive_error),
+    );
+    let max_final = max(&|r| r.final_position_error.unwrap_or(f64::INFINITY));
+    let max_theta = max(&|r| r.theta);
+    let failed = rows.len() - passed;
+    if args.json {
+        let designs: Vec<_> = rows
+            .iter()
+            .map(|row| match &row.result {
+                Ok(r) => json!({
+                    "design": row.name,
+                    "vertices": row.vertices,
+                    "free_vertices": r.free_vertices,
+                    "steps": r.steps,
+                    "compared_states": r.compared_states,
+                    "gamma": r.gamma,
+                    "max_delta": r.max_delta,
+                    "rigid": r.rigid,
+                    "theta": r.theta,
+                    "max_position_error": r.max_position_error,
+                    "final_position_error": r.final_position_error,
+                    "drive_error": r.drive_error,
+                    "start_gap": r.start_gap,
+                    "agrees": pass(r),
+                }),
+                Err(e) => json!({"design": row.name, "error": e, "agrees": false}),
+            })
+            .collect();
+        let out = json!({
+            "designs": designs,
+            "count": rows.len(),
+            "agree": passed,
+            "max_gamma": max_gamma,
+            "max_delta": max_delta,
+            "max_position_error": max_err,
+            "max_final_position_error": max_final,
+            "max_drive_error": max_drive,
+            "max_theta": max_theta,
+            "gamma_tol": GAMMA_TOL,
+            "position_tol": POSITION_TOL,
+            "seconds": seconds,
+        });
+        emit(&(serde_json::to_string_pretty(&out)? + "\n"))?;
+    } else {
+        let mut o = String::new();
+        let _ = writeln!(
+            o,
+            "{:<14} {:>3} {:>4} {:>3} {:>10} {:>10} {:>10} {:>10} {:>6}  agrees",
+            "design", "n", "free", "J", "Gamma", "max delta", "max |x-X|", "final", "theta"
+        );
+        for row in &rows {
+            match &row.result {
+                Ok(r) => {
+                    let _ = writeln!(
+                        o,
+                        "{:<14} {:>3} {:>4} {:>3} {:>10.2e} {:>10.2e} {:>10.2e} {:>10} {:>6.3}  {}",
+                        row.name,
+                        row.vertices,
+                        r.free_vertices,
+                        r.steps,
+                        r.gamma,
+                        r.max_delta,
+                        r.max_position_error,
+                        r.final_position_error
+                            .map_or("-".into(), |e| format!("{e:.2e}")),
+                        r.theta,
+                        if pass(r) { "yes" } else { "NO" }
+                    );
+                }
+                Err(e) => {
+                    let _ = writeln!(o, "{:<14} error: {e}", row.name);
+                }
+            }
+        }
+        let _ = writeln!(
+            o,
+            "{} designs, {passed} agree with the PTU (Γ <= {GAMMA_TOL:e}, |x - X| <= {POSITION_TOL:e} at every compared state)",
+            rows.len()
+        );
+        let _ = writeln!(
+            o,
+            "max Γ {max_gamma:.3e}, max δ(j) {max_delta:.3e}, max |x - X| {max_err:.3e} (final state {max_final:.3e}), prescribed vertices {max_drive:.3e}, max θ {max_theta:.3}"
+        );
+        let _ = writeln!(o, "time {seconds:.2} s");
+        emit(&o)?;
+    }
+    if failed > 0 {
+        bail!("{failed} of {} designs do not agree with the PTU", rows.len());
+    }
+    Ok(())
 }
 
 /// Write to stdout; a closed pipe (`| head`) ends the output quietly instead of failing.
@@ -76,34 +528,40 @@ pub(crate) fn emit(text: &str) -> anyhow::Result<()> {
     }
 }
 
-fn table(file: &PatternFile, r: &SimReport, seconds: f64) -> String {
-    let mut o = String::new();
-    let _ = writeln!(o, "{}", file.name);
-    let _ = writeln!(
+/// The per-step table; with a cross-validation, a column of the distance to the PTU.
+fn steps_table(o: &mut String, r: &SimReport, cv: Option<&CrossvalReport>) {
+    let _ = write!(
         o,
-        "{} vertices ({} free), {} facets, {} bars, J = {}",
-        file.vertex_names.len(),
-        r.free_vertices,
-        file.input.faces.len(),
-        r.bars,
-        r.steps.len()
-    );
-    let _ = writeln!(
-        o,
-        "{:>4} {:>12} {:>12} {:>12} {:>5}  intersection",
+        "{:>4} {:>12} {:>12} {:>12} {:>5}",
         "j", "t", "delta(j)", "sum|l-lt|", "iter"
     );
+    if cv.is_some() {
+        let _ = write!(o, " {:>11}", "|x - X_PTU|");
+    }
+    let _ = writeln!(o, "  intersection");
     for s in &r.steps {
         let x = match &s.intersection {
             Some(i) => format!("{:?} f{}-f{}", i.kind, i.face_a, i.face_b),
             None => String::new(),
         };
-        let _ = writeln!(
+        let _ = write!(
             o,
-            "{:>4} {:>12.6} {:>12.3e} {:>12.3e} {:>5}  {}",
-            s.j, s.t, s.delta, s.delta_length, s.iterations, x
+            "{:>4} {:>12.6} {:>12.3e} {:>12.3e} {:>5}",
+            s.j, s.t, s.delta, s.delta_length, s.iterations
         );
+        if let Some(cv) = cv {
+            let e = cv
+                .states
+                .get(s.j)
+                .and_then(|c| c.position_error)
+                .map_or("-".into(), |e| format!("{e:.3e}"));
+            let _ = write!(o, " {e:>11}");
+        }
+        let _ = writeln!(o, "  {x}");
     }
+}
+
+fn summary(o: &mut String, r: &SimReport) {
     if !r.initial_intersections.is_empty() {
         let _ = writeln!(
             o,
@@ -123,14 +581,15 @@ fn table(file: &PatternFile, r: &SimReport, seconds: f64) -> String {
             format!("not rigid (some delta(j) > {RIGID_DELTA:e})")
         }
     );
+}
+
+fn positions(o: &mut String, names: &[String], x: &[[f64; 3]]) {
     let _ = writeln!(o, "final positions:");
-    for (name, p) in file.vertex_names.iter().zip(r.final_positions()) {
+    for (name, p) in names.iter().zip(x) {
         let _ = writeln!(
             o,
             "  {name:>8}  ({:>10.6}, {:>10.6}, {:>10.6})",
             p[0], p[1], p[2]
         );
     }
-    let _ = writeln!(o, "time                {:.3} s", seconds);
-    o
 }

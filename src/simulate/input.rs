@@ -118,16 +118,24 @@ impl Drive {
     }
 }
 
-/// Stopping rules of the per-step least-squares solve.
+/// Stopping rules of the per-step least-squares solve, and the step control.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverSettings {
-    /// Most Levenberg–Marquardt iterations per step.
+    /// Most Levenberg–Marquardt iterations per solve.
     pub max_iterations: usize,
     /// Stop when a step changes no coordinate by more than this, relative to the largest
     /// coordinate magnitude.
     pub step_tolerance: f64,
     /// Stop when the largest |l² − l_t²| is at most this (absolute, squared length units).
     pub residual_tolerance: f64,
+    /// Continuation step control: a (sub)step is halved when the solve has to move the
+    /// free vertices from the predicted start by more than this fraction of the step's
+    /// whole displacement (largest coordinate change each). A corrector that large means
+    /// the predictor was poor, and near a bifurcation it may have converged to the
+    /// neighbouring branch; smaller steps make the predictor better (its error falls as
+    /// the step squared) while branches stay apart. `f64::INFINITY` (the default) turns
+    /// it off; the cross-validation uses 0.02 (see [`super::crossval`]).
+    pub max_correction: f64,
 }
 
 impl Default for SolverSettings {
@@ -137,6 +145,7 @@ impl Default for SolverSettings {
             max_iterations: 200,
             step_tolerance: 1e-15,
             residual_tolerance: 1e-15,
+            max_correction: f64::INFINITY,
         }
     }
 }
@@ -163,9 +172,13 @@ pub struct SimInput {
     pub t_end: f64,
     /// Number of folding steps J (states t_1 … t_J after t_0 = t_start).
     pub steps: usize,
-    /// Offsets added to the start point of the first step only (not to the target
-    /// lengths): they pick a branch at a bifurcation such as the flat state, where the
-    /// thesis relied on non-developable starts.
+    /// The displacement of these vertices over the first step on the branch to follow,
+    /// e.g. X(t₁) − X(t₀) of a reference motion (not a change of the target lengths). It
+    /// picks a branch at a bifurcation such as the flat state, where the thesis relied on
+    /// non-developable starts: every solve within the first step, from a state at t′ to
+    /// t, starts its free vertices at `x(t′) + offset·(t − t′)/(t₁ − t₀)`, so a first
+    /// step refined into substeps follows it too. Offsets of prescribed or fixed vertices
+    /// are ignored.
     pub first_step_offsets: Vec<(usize, [f64; 3])>,
     /// Check self-intersection at every step (θ); off, θ is reported as 0.
     pub check_intersections: bool,

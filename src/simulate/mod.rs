@@ -12,6 +12,7 @@
 //! * [`pattern_file`] — the `grammar/*.toml` pattern format;
 //! * [`solver`] — the per-step Levenberg–Marquardt solve;
 //! * [`run`] — the simulation loop and its report;
+//! * [`crossval`] — the simulator against the PTU's designs (same drive, same states);
 //! * [`flasher`] — the adapted four-sided flasher task of Sec. 3.3–3.7 and its simulated
 //!   annealing.
 //!
@@ -38,6 +39,7 @@
 //! assert!(report.rigid && report.gamma < 1e-12 && report.theta == 0.0);
 //! ```
 
+pub mod crossval;
 pub mod flasher;
 pub mod formula;
 pub mod input;

@@ -44,8 +44,9 @@
 //!   `drive` and `first_step_offset`, which are replicated, `v@m` means "m copies further
 //!   on" from the copy being built. `faces_once` and `fixed` are not replicated, and there
 //!   `v@m` names copy m itself.
-//! * `[[first_step_offset]] vertex = "v", offset = [dx, dy, dz]`: added to the start point
-//!   of the first step only, to pick a branch (mountain or valley) at the flat state.
+//! * `[[first_step_offset]] vertex = "v", offset = [dx, dy, dz]`: the vertex's displacement
+//!   over the first step on the branch to follow (mountain or valley at the flat state);
+//!   see [`SimInput::first_step_offsets`].
 //!
 //! Unknown keys are errors, and every error names the file and the field.
 

@@ -107,10 +107,23 @@ struct Stepper<'a> {
     branch_tol: f64,
     iterations: usize,
     substeps: usize,
+    /// The first step's displacement of every vertex (from `first_step_offsets`, zero
+    /// elsewhere) and the step's length in t; `None` without offsets.
+    hint: Option<(Vec<[f64; 3]>, f64)>,
+    /// How far the last solve moved the free vertices from its predicted start.
+    last_correction: f64,
 }
 
 impl Stepper<'_> {
-    fn solve_at(&mut self, t: f64, start: &[[f64; 3]]) -> Result<Vec<[f64; 3]>, SimError> {
+    /// Solve at `t` starting from the state `start` reached at `t_from`; `before` is an
+    /// earlier state on the same branch and its t, when there is one.
+    fn solve_at(
+        &mut self,
+        t: f64,
+        start: &[[f64; 3]],
+        t_from: f64,
+        before: Option<(&[[f64; 3]], f64)>,
+    ) -> Result<Vec<[f64; 3]>, SimError> {
         let mut x = start.to_vec();
         for (v, xv) in x.iter_mut().enumerate() {
             if let Some(p) = self.supports.position(v, t, &self.input.initial[v]) {
@@ -120,7 +133,41 @@ impl Stepper<'_> {
                 *xv = p;
             }
         }
-        predict(self.bars, self.slot, self.n_free, start, &mut x);
+        match &self.hint {
+            // Within the first step, which leaves the initial state (a bifurcation such
+            // as the flat state, where the tangent is not unique), follow the given
+            // first-step displacement, scaled to this (sub)step: the straight path to
+            // X(t₁) stays nearer the intended branch than to any other, as branches part
+            // linearly in t.
+            Some((dx, len)) if (t_from - self.input.t_start).abs() < 0.5 * len.abs() => {
+                let s = (t - t_from) / len;
+                for (v, s_v) in self.slot.iter().enumerate() {
+                    if s_v.is_some() {
+                        for u in 0..3 {
+                            x[v][u] = start[v][u] + s * dx[v][u];
+                        }
+                    }
+                }
+            }
+            // With a state behind, extrapolate along the secant: it follows the branch the
+            // motion is on even where the linearised bars barely tell the branches apart
+            // (near the flat state, where a vertex's creases have only just begun to fold),
+            // which the tangent predictor, solved from those bars, cannot.
+            _ => match before {
+                Some((xb, tb)) if tb != t_from => {
+                    let s = (t - t_from) / (t_from - tb);
+                    for (v, s_v) in self.slot.iter().enumerate() {
+                        if s_v.is_some() {
+                            for u in 0..3 {
+                                x[v][u] = start[v][u] + s * (start[v][u] - xb[v][u]);
+                            }
+                        }
+                    }
+                }
+                _ => predict(self.bars, self.slot, self.n_free, start, &mut x),
+            },
+        }
+        let predicted = x.clone();
         let stats = solve(
             self.bars,
             self.slot,
@@ -129,6 +176,11 @@ impl Stepper<'_> {
             &self.input.solver,
         );
         self.iterations += stats.iterations;
+        self.last_correction = x
+            .iter()
+            .zip(&predicted)
+            .flat_map(|(a, b)| (0..3).map(move |u| (a[u] - b[u]).abs()))
+            .fold(0.0, f64::max);
         Ok(x)
     }
 
@@ -138,26 +190,45 @@ impl Stepper<'_> {
         t0: f64,
         t1: f64,
         depth: usize,
+        before: Option<(&[[f64; 3]], f64)>,
     ) -> Result<Vec<[f64; 3]>, SimError> {
-        let full = self.solve_at(t1, x0)?;
+        let full = self.solve_at(t1, x0, t0, before)?;
+        let corrected = self.last_correction;
+        let moved = full
+            .iter()
+            .zip(x0)
+            .flat_map(|(a, b)| (0..3).map(move |u| (a[u] - b[u]).abs()))
+            .fold(0.0, f64::max);
+        // A first step whose given displacement already lands on a solution is the branch
+        // the caller chose; the half-step test would only second-guess it with the cruder
+        // linear path to t_m.
+        if depth == 0
+            && self.hint.is_some()
+            && t0 == self.input.t_start
+            && self.last_correction <= self.branch_tol
+        {
+            self.substeps += 1;
+            return Ok(full);
+        }
         if depth >= MAX_REFINE {
             self.substeps += 1;
             return Ok(full);
         }
         let tm = 0.5 * (t0 + t1);
-        let mid = self.solve_at(tm, x0)?;
-        let two = self.solve_at(t1, &mid)?;
+        let mid = self.solve_at(tm, x0, t0, before)?;
+        let two = self.solve_at(t1, &mid, tm, Some((x0, t0)))?;
         let gap = full
             .iter()
             .zip(&two)
             .flat_map(|(a, b)| (0..3).map(move |u| (a[u] - b[u]).abs()))
             .fold(0.0, f64::max);
-        if gap <= self.branch_tol {
+        let kappa: f64 = std::env::var("FS_KAPPA").ok().and_then(|v| v.parse().ok()).unwrap_or(self.input.solver.max_correction);
+        if gap <= self.branch_tol && corrected <= kappa * moved {
             self.substeps += 1;
             return Ok(two);
         }
-        let xa = self.advance(x0, t0, tm, depth + 1)?;
-        self.advance(&xa, tm, t1, depth + 1)
+        let xa = self.advance(x0, t0, tm, depth + 1, before)?;
+        self.advance(&xa, tm, t1, depth + 1, Some((x0, t0)))
     }
 }
 
@@ -218,22 +289,30 @@ pub fn simulate_with_checker(
         branch_tol: BRANCH_TOLERANCE * scale,
         iterations: 0,
         substeps: 0,
+        hint: None,
+        last_correction: 0.0,
     };
+    if !input.first_step_offsets.is_empty() {
+        let mut dx = vec![[0.0; 3]; n];
+        for &(v, off) in &input.first_step_offsets {
+            dx[v] = off;
+        }
+        stepper.hint = Some((dx, (input.t_end - input.t_start) / jj as f64));
+    }
     let mut t_prev = input.t_start;
+    let mut before: Option<(Vec<[f64; 3]>, f64)> = None;
     for j in 1..=jj {
         let t = input.t_start + (input.t_end - input.t_start) * j as f64 / jj as f64;
-        if j == 1 {
-            for &(v, off) in &input.first_step_offsets {
-                if slot[v].is_some() {
-                    for u in 0..3 {
-                        x[v][u] += off[u];
-                    }
-                }
-            }
-        }
         stepper.iterations = 0;
         stepper.substeps = 0;
-        x = stepper.advance(&x, t_prev, t, 0)?;
+        let next = stepper.advance(
+            &x,
+            t_prev,
+            t,
+            0,
+            before.as_ref().map(|(xb, tb)| (xb.as_slice(), *tb)),
+        )?;
+        before = Some((std::mem::replace(&mut x, next), t_prev));
         t_prev = t;
         let intersection = match &mut tracker {
             Some(tr) => tr.step(&x, t, true).into_iter().next(),

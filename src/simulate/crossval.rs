@@ -1,0 +1,736 @@
+//! Cross-validation: the bar-and-hinge simulator against the PTU (issue 8, thesis Sec. 3
+//! against Sec. 4–5).
+//!
+//! A PTU design comes as a [`Pattern`]: its flat layout, its facets and the folded frames
+//! the model computed. The simulator gets the same flat layout and facets, and the motion
+//! the PTU prescribes for the design task's actuation (SPEC §4), [`G0Drive`]:
+//!
+//! * the two ends of the driven crease stay at their flat positions;
+//! * every vertex of the facet left of the crease (tail → head) turns by +ρ(t)/2 about the
+//!   crease, every vertex of the facet right of it by −ρ(t)/2;
+//! * every other vertex is free: only the bars place it.
+//!
+//! Why trajectories and not a crease drive with one facet fixed: the PTU *defines* the
+//! maps of those two facets as exactly these rotations ([`crate::model::geometry::fold`]),
+//! so prescribing their vertices is exact, adds no approximation, and leaves the simulated
+//! states in the PTU's own frame — positions compare directly, without aligning frames. A
+//! crease drive would move the whole pattern by the rigid motion Rot(−ρ/2) relative to the
+//! PTU, exact too, but only after an alignment that could hide an error of its own.
+//!
+//! The flat state is a bifurcation (every crease can start either way), so the first step
+//! starts from the PTU's own first state ([`SimInput::first_step_offsets`] = X(t₁) − X(0)
+//! for the free vertices); from there continuation follows the branch.
+//!
+//! Then every simulated state j ≥ 1 whose t has a frame is compared with it: the largest
+//! distance between a simulated vertex and the PTU's. Tolerances, [`GAMMA_TOL`] and
+//! [`POSITION_TOL`], are explained where they are defined.
+//!
+//! ```no_run
+//! use foldsynth::grammar::CreaseGraph;
+//! use foldsynth::model::Model;
+//! use foldsynth::simulate::crossval::{CrossvalOptions, crossval_design};
+//! use foldsynth::task::Task;
+//! let task = Task::load("grammar/gripper.toml".as_ref()).unwrap();
+//! let graph = CreaseGraph::from_sequence(&task, "2").unwrap();
+//! let model = Model::new(&graph, &task, 0).unwrap();
+//! let mid: Vec<f64> = model.free.iter().map(|&i| {
+//!     let (lo, hi) = model.var_bounds(i);
+//!     0.5 * (lo + hi)
+//! }).collect();
+//! let r = crossval_design(&model, model.full_vars(&mid), vec![1.0], 30,
+//!                         &CrossvalOptions::default()).unwrap();
+//! println!("Γ = {:e}, max |x − X_PTU| = {:e}", r.gamma, r.max_position_error);
+//! ```
+
+use std::sync::Arc;
+
+use nalgebra::{Rotation3, Unit, Vector3};
+use serde::Serialize;
+use thiserror::Error;
+
+use super::input::{AngleFn, Drive, SimInput, SolverSettings};
+use super::run::{RIGID_DELTA, SimError, SimReport, simulate_with_checker};
+use crate::check::{CheckError, Checker};
+use crate::model::Model;
+use crate::model::numeric::{Evaluated, sample_times};
+use crate::pattern::{EdgeKind, Pattern};
+
+/// Largest Γ (Eq. 4, squared-length units) of a design that folds rigidly. A rigid step
+/// converges to rounding (δ ~ 1e-15 … 1e-13 on the gripper's designs); the issue's 1e-8
+/// leaves room for ill-conditioned states near a vertex's rigid limit (Eq. 33 keeps
+/// optimized designs 1e-8 inside it), and sits four orders below the thesis's 1e-4.
+pub const GAMMA_TOL: f64 = 1e-8;
+
+/// Largest distance between a simulated and a PTU vertex (paper units: G0's crease has
+/// length 1). The two are solved independently to rounding, but positions inherit the
+/// conditioning of the state: where a vertex's unit triangle is nearly degenerate (close
+/// to the rigid limit, or to the flat state) a bar residual ε moves a vertex by up to
+/// ~√ε, i.e. ~1e-8 for ε ~ 1e-15 … 1e-16. 1e-7 is a decade above that and far below any
+/// geometric difference a wrong branch or a wrong kinematics would make (≥ 1e-3).
+pub const POSITION_TOL: f64 = 1e-7;
+
+/// Two values of t name the same state when they differ by at most this (relative).
+const SAME_T: f64 = 1e-9;
+
+/// Why a cross-validation could not run.
+#[derive(Debug, Error)]
+pub enum CrossvalError {
+    /// No edge is marked as the driven crease.
+    #[error(
+        "no crease is marked as driven (a foldsynth design marks G0's crease; name it with --driven EDGE)"
+    )]
+    NoDrivenCrease,
+    /// More than one edge is marked driven; G0 drives one.
+    #[error(
+        "edges {0:?} are all marked as driven; the design task's actuation drives exactly one crease (name it with --driven EDGE)"
+    )]
+    SeveralDrivenCreases(Vec<usize>),
+    /// The driven edge does not exist.
+    #[error("edge {edge} does not exist (the pattern has {count} edges, 0-based)")]
+    EdgeOutOfRange {
+        /// The edge asked for.
+        edge: usize,
+        /// Number of edges.
+        count: usize,
+    },
+    /// The driven edge is a side of the paper.
+    #[error("edge {0} is a boundary edge, not a crease")]
+    BoundaryEdge(usize),
+    /// The driven crease does not have one facet on each side.
+    #[error(
+        "crease {edge} ({tail}→{head}) must have exactly one facet on each side; found {left} traversing {tail}→{head} and {right} traversing {head}→{tail}"
+    )]
+    NotBetweenTwoFacets {
+        /// The edge.
+        edge: usize,
+        /// Its tail.
+        tail: usize,
+        /// Its head.
+        head: usize,
+        /// Facets traversing tail → head.
+        left: usize,
+        /// Facets traversing head → tail.
+        right: usize,
+    },
+    /// The drive does not start flat (the simulation starts from the flat layout).
+    #[error(
+        "the driven crease's fold angle at t_start = {t_start} is {angle} rad; the simulation starts from the flat layout, so it must be 0"
+    )]
+    NotFlatAtStart {
+        /// Start of the motion.
+        t_start: f64,
+        /// The fold angle there.
+        angle: f64,
+    },
+    /// The fold angle cannot be read from the frames.
+    #[error("{0}")]
+    Angle(String),
+    /// The range of t is missing or empty.
+    #[error("{0}")]
+    Motion(String),
+    /// The facets cannot be checked for intersection.
+    #[error("intersection check: {0}")]
+    Check(#[from] CheckError),
+    /// The simulation failed.
+    #[error(transparent)]
+    Sim(#[from] SimError),
+}
+
+/// The design task's actuation (SPEC §4): crease `edge` of the pattern, run tail → head
+/// (`edges[edge].v[0] → v[1]`), folded to `angle(t)` mirror-symmetrically.
+#[derive(Clone)]
+pub struct G0Drive {
+    /// Index into [`Pattern::edges`].
+    pub edge: usize,
+    /// The fold angle ρ(t), valley positive; ρ(t_start) must be 0.
+    pub angle: AngleFn,
+    /// Where the angle comes from, for reports (`t`, a formula, "frames").
+    pub source: String,
+}
+
+impl std::fmt::Debug for G0Drive {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("G0Drive")
+            .field("edge", &self.edge)
+            .field("source", &self.source)
+            .finish_non_exhaustive()
+    }
+}
+
+impl G0Drive {
+    /// The one edge of `pattern` marked as a driven crease.
+    pub fn marked_edge(pattern: &Pattern) -> Result<usize, CrossvalError> {
+        let driven: Vec<usize> = pattern
+            .edges
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| matches!(e.kind, EdgeKind::Crease { driven: true }))
+            .map(|(i, _)| i)
+            .collect();
+        match driven.as_slice() {
+            [] => Err(CrossvalError::NoDrivenCrease),
+            [e] => Ok(*e),
+            _ => Err(CrossvalError::SeveralDrivenCreases(driven)),
+        }
+    }
+
+    /// The drive of crease `edge` with the fold angle its frames show: `ρ(t) = t` when every
+    /// frame has exactly that (the design tasks' `drive = "t"`, then exact at every t);
+    /// otherwise the piecewise-linear interpolation of the frames' angles (exact at the
+    /// frames, which are the states compared; between them it only guides the solver's
+    /// trial half steps).
+    pub fn from_frames(pattern: &Pattern, edge: usize) -> Result<G0Drive, CrossvalError> {
+        check_edge(pattern, edge)?;
+        let mut pts: Vec<(f64, f64)> = pattern
+            .frames
+            .iter()
+            .filter_map(|f| f.fold_angles.get(edge).map(|&a| (f.t, a)))
+            .collect();
+        if pts.is_empty() {
+            return Err(CrossvalError::Angle(format!(
+                "the pattern has no frames with a fold angle for crease {edge}; give the angle as a formula in t (--angle)"
+            )));
+        }
+        if pts.iter().any(|(t, a)| !t.is_finite() || !a.is_finite()) {
+            return Err(CrossvalError::Angle(
+                "a frame has a non-finite t or fold angle".into(),
+            ));
+        }
+        if pts
+            .iter()
+            .all(|(t, a)| (a - t).abs() <= SAME_T * t.abs().max(1.0))
+        {
+            return Ok(G0Drive {
+                edge,
+                angle: Arc::new(|t| t),
+                source: "t".into(),
+            });
+        }
+        if pts.len() < 2 {
+            return Err(CrossvalError::Angle(format!(
+                "one frame cannot define the fold angle of crease {edge} over the motion; give it as a formula in t (--angle)"
+            )));
+        }
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if pts.windows(2).any(|w| w[1].0 <= w[0].0) {
+            return Err(CrossvalError::Angle(
+                "two frames have the same t; the fold angle cannot be interpolated".into(),
+            ));
+        }
+        // Frames store angles wrapped into (−π, π]: unwrap so the interpolation is continuous.
+        for k in 1..pts.len() {
+            let prev = pts[k - 1].1;
+            let tau = std::f64::consts::TAU;
+            pts[k].1 -= tau * ((pts[k].1 - prev) / tau).round();
+        }
+        Ok(G0Drive {
+            edge,
+            angle: Arc::new(move |t| interpolate(&pts, t)),
+            source: "frames (interpolated)".into(),
+        })
+    }
+}
+
+/// Piecewise-linear through `pts` (sorted by t, at least two), extended linearly.
+fn interpolate(pts: &[(f64, f64)], t: f64) -> f64 {
+    let k = pts
+        .partition_point(|p| p.0 <= t)
+        .clamp(1, pts.len() - 1);
+    let ((t0, a0), (t1, a1)) = (pts[k - 1], pts[k]);
+    a0 + (a1 - a0) * (t - t0) / (t1 - t0)
+}
+
+fn check_edge(pattern: &Pattern, edge: usize) -> Result<(), CrossvalError> {
+    let e = pattern
+        .edges
+        .get(edge)
+        .ok_or(CrossvalError::EdgeOutOfRange {
+            edge,
+            count: pattern.edges.len(),
+        })?;
+    match e.kind {
+        EdgeKind::Boundary => Err(CrossvalError::BoundaryEdge(edge)),
+        EdgeKind::Crease { .. } => Ok(()),
+    }
+}
+
+/// Whether facet `f` runs along `p → q`.
+fn traverses(f: &[usize], p: usize, q: usize) -> bool {
+    (0..f.len()).any(|k| f[k] == p && f[(k + 1) % f.len()] == q)
+}
+
+/// The simulator input of `pattern` driven by `drive` over `[t_start, t_end]` in `steps`
+/// steps, starting from the flat layout: the driven crease's ends fixed, the vertices of
+/// its two facets on their rotations, everything else free. No branch offsets (see
+/// [`branch_offsets`]) and no intersection check; the caller adds them.
+pub fn g0_input(
+    pattern: &Pattern,
+    drive: &G0Drive,
+    t_start: f64,
+    t_end: f64,
+    steps: usize,
+) -> Result<SimInput, CrossvalError> {
+    check_edge(pattern, drive.edge)?;
+    let [tail, head] = pattern.edges[drive.edge].v;
+    let left: Vec<usize> = (0..pattern.faces.len())
+        .filter(|&f| traverses(&pattern.faces[f], tail, head))
+        .collect();
+    let right: Vec<usize> = (0..pattern.faces.len())
+        .filter(|&f| traverses(&pattern.faces[f], head, tail))
+        .collect();
+    if left.len() != 1 || right.len() != 1 {
+        return Err(CrossvalError::NotBetweenTwoFacets {
+            edge: drive.edge,
+            tail,
+            head,
+            left: left.len(),
+            right: right.len(),
+        });
+    }
+    if !t_start.is_finite() || !t_end.is_finite() {
+        return Err(CrossvalError::Motion(
+            "the range of t must be finite".into(),
+        ));
+    }
+    let rho0 = (drive.angle)(t_start);
+    if rho0.is_nan() || rho0.abs() > 1e-12 {
+        return Err(CrossvalError::NotFlatAtStart {
+            t_start,
+            angle: rho0,
+        });
+    }
+    let initial = pattern.flat_coords();
+    let origin = Vector3::from(initial[tail]);
+    let axis = Unit::new_normalize(Vector3::from(initial[head]) - origin);
+    let mut drives = Vec::new();
+    for (face, sign) in [(left[0], 0.5), (right[0], -0.5)] {
+        for &v in &pattern.faces[face] {
+            if v == tail || v == head {
+                continue;
+            }
+            let p = Vector3::from(initial[v]) - origin;
+            let angle = drive.angle.clone();
+            // Subtract ρ(t_start) so the path starts exactly at the flat position.
+            drives.push(Drive::Trajectory {
+                vertex: v,
+                path: Arc::new(move |t| {
+                    let r = Rotation3::from_axis_angle(&axis, sign * (angle(t) - rho0));
+                    let x = origin + r * p;
+                    [x.x, x.y, x.z]
+                }),
+            });
+        }
+    }
+    Ok(SimInput {
+        initial,
+        faces: pattern.faces.clone(),
+        extra_bars: Vec::new(),
+        fixed: vec![tail, head],
+        drives,
+        t_start,
+        t_end,
+        steps,
+        first_step_offsets: Vec::new(),
+        check_intersections: false,
+        solver: SolverSettings::default(),
+    })
+}
+
+/// The apex of a rigid panel: a vertex off the facet's plane joined by bars to every
+/// corner of the facet.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PanelApex {
+    /// Its vertex index in the simulator input (after the pattern's vertices).
+    pub vertex: usize,
+    /// The facet it stiffens.
+    pub face: usize,
+    /// Its height above the facet's centroid (the facet's RMS radius).
+    pub height: f64,
+}
+
+/// Centroid + height · unit normal (Newell's, right-handed with the facet's vertex order)
+/// of facet `face` at `coords`: where a rigid panel's apex is when the facet is where
+/// `coords` puts it.
+fn apex_at(coords: &[[f64; 3]], face: &[usize], height: f64) -> [f64; 3] {
+    let k = face.len() as f64;
+    let mut c = [0.0; 3];
+    let mut n = Vector3::zeros();
+    for (i, &v) in face.iter().enumerate() {
+        let (a, b) = (coords[v], coords[face[(i + 1) % face.len()]]);
+        for u in 0..3 {
+            c[u] += a[u] / k;
+        }
+        n += Vector3::new(
+            (a[1] - b[1]) * (a[2] + b[2]),
+            (a[2] - b[2]) * (a[0] + b[0]),
+            (a[0] - b[0]) * (a[1] + b[1]),
+        );
+    }
+    let n = n / n.norm();
+    [0, 1, 2].map(|u| c[u] + height * n[u])
+}
+
+/// Make every facet with more than three vertices a rigid panel: one apex vertex above
+/// its centroid, joined by bars to all its corners.
+///
+/// Why: Eq. 2's bars on the sides and diagonals of a *flat* polygon with four or more
+/// corners do not hold it flat to first order — a corner moving off the plane of three
+/// others changes their bar lengths only at second order (a zero-volume tetrahedron is
+/// infinitesimally flexible). The bar model then has a flex at every state, its solution
+/// is pinned only to √δ or worse, and a small residual lets the facets bend: positions
+/// drift by 1e-7 … 1e-3 with Γ still far below 1e-4. The apex bars make each panel a
+/// first-order rigid body, so a rigidly foldable design has isolated solutions that the
+/// solver finds to rounding — and a design that is not rigidly foldable cannot hide its
+/// distortion in bent panels. Triangles are rigid already and get no apex.
+pub fn add_panel_apexes(input: &mut SimInput) -> Vec<PanelApex> {
+    let mut apexes = Vec::new();
+    for (f, face) in input.faces.iter().enumerate() {
+        if face.len() <= 3 {
+            continue;
+        }
+        let k = face.len() as f64;
+        let c: [f64; 3] =
+            [0, 1, 2].map(|u| face.iter().map(|&v| input.initial[v][u]).sum::<f64>() / k);
+        let r2 = face
+            .iter()
+            .map(|&v| dist(&input.initial[v], &c).powi(2))
+            .sum::<f64>()
+            / k;
+        let height = r2.sqrt();
+        if height.is_nan() || height <= 0.0 {
+            continue; // a degenerate facet: nothing to stiffen
+        }
+        let vertex = input.initial.len();
+        input.initial.push(apex_at(&input.initial, face, height));
+        for &v in face {
+            input.extra_bars.push([vertex, v]);
+        }
+        apexes.push(PanelApex {
+            vertex,
+            face: f,
+            height,
+        });
+    }
+    apexes
+}
+
+/// Offsets that start the first step on the PTU's branch: for every vertex, the frame
+/// after `t_start` nearest to it minus the flat position, scaled linearly to the first
+/// step (exactly X(t₁) − X(0) when a frame sits at t₁); panel apexes follow their
+/// facets. Empty without such a frame.
+pub fn branch_offsets(
+    pattern: &Pattern,
+    input: &SimInput,
+    apexes: &[PanelApex],
+) -> Vec<(usize, [f64; 3])> {
+    let dir = (input.t_end - input.t_start).signum();
+    let t1 = input.t_start + (input.t_end - input.t_start) / input.steps.max(1) as f64;
+    let next = pattern
+        .frames
+        .iter()
+        .filter(|f| {
+            (f.t - input.t_start) * dir > SAME_T * input.t_start.abs().max(1.0)
+                && f.coords.len() == pattern.vertices.len()
+        })
+        .min_by(|a, b| {
+            ((a.t - input.t_start) * dir).total_cmp(&((b.t - input.t_start) * dir))
+        });
+    let Some(f) = next else {
+        return Vec::new();
+    };
+    let s = if same_t(f.t, t1) {
+        1.0
+    } else {
+        (t1 - input.t_start) / (f.t - input.t_start)
+    };
+    let mut at = f.coords.clone();
+    for a in apexes {
+        at.push(apex_at(&f.coords, &input.faces[a.face], a.height));
+    }
+    at.iter()
+        .zip(&input.initial)
+        .enumerate()
+        .map(|(v, (x, x0))| (v, [0, 1, 2].map(|k| s * (x[k] - x0[k]))))
+        .filter(|(_, o)| o.iter().all(|c| c.is_finite()))
+        .collect()
+}
+
+fn same_t(a: f64, b: f64) -> bool {
+    (a - b).abs() <= SAME_T * a.abs().max(b.abs()).max(1.0)
+}
+
+fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// Settings of [`crossval`].
+#[derive(Clone, Debug)]
+pub struct CrossvalOptions {
+    /// Number of steps J (default: one per frame after the first).
+    pub steps: Option<usize>,
+    /// End of the motion (default: the last frame's t).
+    pub t_end: Option<f64>,
+    /// Also measure self-intersection (θ) at every step.
+    pub check_intersections: bool,
+    /// Make facets with more than three vertices rigid panels ([`add_panel_apexes`])
+    /// instead of Eq. 2's bars alone.
+    pub rigid_panels: bool,
+    /// Solver stopping rules.
+    pub solver: SolverSettings,
+}
+
+impl Default for CrossvalOptions {
+    fn default() -> Self {
+        CrossvalOptions {
+            steps: None,
+            t_end: None,
+            check_intersections: false,
+            rigid_panels: true,
+            solver: SolverSettings {
+                max_iterations: 2000,
+                max_correction: 0.02,
+                ..SolverSettings::default()
+            },
+        }
+    }
+}
+
+/// One simulated state next to the PTU's.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StateComparison {
+    /// Step j (0 is the flat start).
+    pub j: usize,
+    /// t_j.
+    pub t: f64,
+    /// δ(j) (0 for the start).
+    pub delta: f64,
+    /// Largest distance between a simulated vertex and the PTU's at t_j (`None` when the
+    /// pattern has no frame at t_j).
+    pub position_error: Option<f64>,
+}
+
+/// The outcome of one cross-validation.
+#[derive(Clone, Debug, Serialize)]
+pub struct CrossvalReport {
+    /// The driven crease (edge index).
+    pub driven_edge: usize,
+    /// Where its fold angle came from.
+    pub angle_source: String,
+    /// J.
+    pub steps: usize,
+    /// Start of the motion.
+    pub t_start: f64,
+    /// End of the motion.
+    pub t_end: f64,
+    /// Rigidity error Γ (Eq. 4).
+    pub gamma: f64,
+    /// Largest δ(j).
+    pub max_delta: f64,
+    /// Every δ(j) ≤ 1e-4 (the thesis's verdict).
+    pub rigid: bool,
+    /// Share of steps with a self-intersection (0 when not checked).
+    pub theta: f64,
+    /// Every state, with its comparison.
+    pub states: Vec<StateComparison>,
+    /// Number of simulated states (j ≥ 1) that had a PTU frame to compare with.
+    pub compared_states: usize,
+    /// Largest position error over the compared states j ≥ 1.
+    pub max_position_error: f64,
+    /// Position error at the last state, if the PTU has a frame there.
+    pub final_position_error: Option<f64>,
+    /// Largest distance between a prescribed vertex (the driven crease's facets) and the
+    /// PTU's frame: how exactly the drive reproduces the PTU's actuation.
+    pub drive_error: f64,
+    /// Largest distance between the PTU's frame at t_start and the flat layout the
+    /// simulation starts from (the PTU's own rounding at the flat, singular state).
+    pub start_gap: Option<f64>,
+    /// Rigid-panel apexes added (0 with Eq. 2's bars alone); their vertices follow the
+    /// pattern's in the simulated states.
+    pub panel_apexes: usize,
+    /// Free vertices of the simulation (apexes included).
+    pub free_vertices: usize,
+    /// Bars.
+    pub bars: usize,
+    /// The simulation itself.
+    #[serde(skip)]
+    pub sim: SimReport,
+}
+
+impl CrossvalReport {
+    /// Γ ≤ `gamma_tol`, at least the final state compared, and every compared state within
+    /// `position_tol`.
+    pub fn agrees(&self, gamma_tol: f64, position_tol: f64) -> bool {
+        self.gamma <= gamma_tol
+            && self.final_position_error.is_some()
+            && self.max_position_error <= position_tol
+    }
+}
+
+/// Simulate `pattern` under `drive` and compare with its frames (see the module docs).
+///
+/// The motion runs from the first frame's t (0 without frames) to `opts.t_end` or the last
+/// frame's t, in `opts.steps` or (frames − 1) steps.
+pub fn crossval(
+    pattern: &Pattern,
+    drive: &G0Drive,
+    opts: &CrossvalOptions,
+) -> Result<CrossvalReport, CrossvalError> {
+    let t_start = pattern.frames.first().map_or(0.0, |f| f.t);
+    let t_end = match (opts.t_end, pattern.frames.last()) {
+        (Some(t), _) => t,
+        (None, Some(f)) if pattern.frames.len() >= 2 => f.t,
+        _ => {
+            return Err(CrossvalError::Motion(
+                "the pattern has fewer than two frames: give the end of the motion (--t-max)"
+                    .into(),
+            ));
+        }
+    };
+    if same_t(t_start, t_end) {
+        return Err(CrossvalError::Motion(format!(
+            "the motion is empty: it starts and ends at t = {t_start}"
+        )));
+    }
+    let steps = match opts.steps {
+        Some(j) if j >= 1 => j,
+        Some(_) => return Err(CrossvalError::Motion("steps must be at least 1".into())),
+        None => pattern.frames.len().saturating_sub(1).max(1),
+    };
+    let mut input = g0_input(pattern, drive, t_start, t_end, steps)?;
+    let apexes = if opts.rigid_panels {
+        add_panel_apexes(&mut input)
+    } else {
+        Vec::new()
+    };
+    input.first_step_offsets = branch_offsets(pattern, &input, &apexes);
+    input.check_intersections = opts.check_intersections;
+    input.solver = opts.solver;
+    let checker = if opts.check_intersections {
+        // Apexes belong to no facet: the checker only needs them counted.
+        let layout: Vec<[f64; 2]> = input.initial.iter().map(|p| [p[0], p[1]]).collect();
+        Some(Checker::new(&layout, &input.faces)?)
+    } else {
+        None
+    };
+    let sim = simulate_with_checker(&input, checker.as_ref())?;
+    Ok(compare(pattern, drive, &input, apexes.len(), sim))
+}
+
+/// Compare a finished simulation with the pattern's frames.
+fn compare(
+    pattern: &Pattern,
+    drive: &G0Drive,
+    input: &SimInput,
+    panel_apexes: usize,
+    sim: SimReport,
+) -> CrossvalReport {
+    let frame_at = |t: f64| {
+        pattern
+            .frames
+            .iter()
+            .find(|f| same_t(f.t, t) && f.coords.len() == pattern.vertices.len())
+    };
+    let mut prescribed: Vec<usize> = input.fixed.clone();
+    prescribed.extend(input.drives.iter().filter_map(|d| match d {
+        Drive::Trajectory { vertex, .. } => Some(*vertex),
+        Drive::Crease { .. } => None,
+    }));
+    let mut states = Vec::with_capacity(sim.states.len());
+    let (mut max_err, mut drive_err, mut compared) = (0.0_f64, 0.0_f64, 0);
+    let mut start_gap = None;
+    for (j, x) in sim.states.iter().enumerate() {
+        let t = if j == 0 {
+            input.t_start
+        } else {
+            sim.steps[j - 1].t
+        };
+        let frame = frame_at(t);
+        let err = frame.map(|f| {
+            x.iter()
+                .zip(&f.coords)
+                .map(|(a, b)| dist(a, b))
+                .fold(0.0, f64::max)
+        });
+        if let Some(f) = frame {
+            let d = prescribed
+                .iter()
+                .map(|&v| dist(&x[v], &f.coords[v]))
+                .fold(0.0, f64::max);
+            if j == 0 {
+                start_gap = err;
+            } else {
+                drive_err = drive_err.max(d);
+                max_err = max_err.max(err.unwrap_or(0.0));
+                compared += 1;
+            }
+        }
+        states.push(StateComparison {
+            j,
+            t,
+            delta: if j == 0 { 0.0 } else { sim.steps[j - 1].delta },
+            position_error: err,
+        });
+    }
+    let final_position_error = states.last().filter(|s| s.j > 0).and_then(|s| s.position_error);
+    CrossvalReport {
+        driven_edge: drive.edge,
+        angle_source: drive.source.clone(),
+        steps: input.steps,
+        t_start: input.t_start,
+        t_end: input.t_end,
+        gamma: sim.gamma,
+        max_delta: sim.max_delta(),
+        rigid: sim.steps.iter().all(|s| s.delta <= RIGID_DELTA),
+        theta: sim.theta,
+        states,
+        compared_states: compared,
+        max_position_error: max_err,
+        final_position_error,
+        drive_error: drive_err,
+        start_gap,
+        panel_apexes,
+        free_vertices: sim.free_vertices,
+        bars: sim.bars,
+        sim,
+    }
+}
+
+/// Cross-validate a design of `model` (full variable vector, ±1 modes) over `[0, t_max]`
+/// in `steps` steps: the PTU's frames are computed at exactly the simulator's t_j, and the
+/// driven crease follows the task's drive expression (exact at every t).
+pub fn crossval_design(
+    model: &Model,
+    full_vars: Vec<f64>,
+    modes: Vec<f64>,
+    steps: usize,
+    opts: &CrossvalOptions,
+) -> Result<CrossvalReport, CrossvalError> {
+    let design = Evaluated::new(&model.plan, full_vars, modes);
+    // Same formula as the simulator's t_j = t_start + (t_end − t_start)·j/J, so the frames
+    // land on the simulated states bit for bit.
+    let pattern = design.pattern(&sample_times(model.t_max, steps.max(1) + 1));
+    let drive = design_drive(model)?;
+    crossval(
+        &pattern,
+        &drive,
+        &CrossvalOptions {
+            steps: Some(steps),
+            t_end: Some(model.t_max),
+            ..opts.clone()
+        },
+    )
+}
+
+/// The G0 drive of a model: its actuated crease (creases come first among a design
+/// pattern's edges, in plan order) with the task's drive expression.
+pub fn design_drive(model: &Model) -> Result<G0Drive, CrossvalError> {
+    let k = model.plan.actuation.crease;
+    let expr = model.plan.creases[k].drive.clone().ok_or_else(|| {
+        CrossvalError::Angle(format!("the model's actuated crease {k} has no drive"))
+    })?;
+    Ok(G0Drive {
+        edge: k,
+        source: expr.to_string(),
+        angle: Arc::new(move |t| expr.eval(&t)),
+    })
+}
