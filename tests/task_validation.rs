@@ -340,9 +340,15 @@ fn types_and_structure_of_extendable_vertices_are_checked() {
         &["2 sectors are open", "exactly one open sector"],
     );
     let e = err(&edit("n_max = 3", "n_max = 99"));
-    assert_err(&e, "grammar.n_max", &["allowed 0..="]);
+    assert_err(&e, "grammar.n_max", &["allowed 1..="]);
     let e = err(&edit("n_max = 3", "n_max = -1"));
-    assert_err(&e, "grammar.n_max", &["allowed 0..="]);
+    assert_err(&e, "grammar.n_max", &["allowed 1..="]);
+    let e = err(&edit("n_max = 3", "n_max = 0"));
+    assert_err(
+        &e,
+        "grammar.n_max",
+        &["allowed 1..=", "at least one vertex"],
+    );
 }
 
 #[test]

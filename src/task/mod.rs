@@ -339,11 +339,11 @@ impl Task {
         let raw: RawTask = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
 
         let n_max = raw.grammar.n_max;
-        if !(0..=N_MAX_LIMIT as i64).contains(&n_max) {
+        if !(1..=N_MAX_LIMIT as i64).contains(&n_max) {
             return Err(cx.err(
                 "grammar.n_max",
                 format!(
-                    "{n_max} is out of range: allowed 0..={N_MAX_LIMIT} (the number of graphs grows about twentyfold per internal vertex)"
+                    "{n_max} is out of range: allowed 1..={N_MAX_LIMIT} (at least one vertex to extend; the number of graphs grows about twentyfold per internal vertex)"
                 ),
             ));
         }
