@@ -484,8 +484,10 @@ pub fn write_all(
 /// `pattern` is [`Pattern`] as serde writes it (`vertices`, `edges` with
 /// `{"v": [i, j], "kind": "boundary" | {"crease": {"driven": bool}}}`, `faces`, `frames`
 /// with `t`, `coords`, `fold_angles` in radians); `meta` is [`DesignMeta`].
+///
+/// Other keys are allowed and ignored: `foldsynth synthesize` writes its designs
+/// (`OUT/designs/<id>.json`) as such files with the optimization's figures beside them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct DesignFile {
     /// The crease pattern and its folded states.
     pub pattern: Pattern,

@@ -495,7 +495,7 @@ impl<'a> Scene<'a> {
             // Opaque white background: premultiplied RGBA equals straight RGBA here.
             let mut rgba = pm.take();
             let mut frame =
-                gif::Frame::from_rgba_speed(size.0 as u16, size.1 as u16, &mut rgba, 10);
+                gif::Frame::from_rgba_speed(size.0 as u16, size.1 as u16, &mut rgba, 30);
             frame.delay = if k + 1 == n {
                 delay_cs.saturating_mul(8).max(50)
             } else {

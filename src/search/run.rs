@@ -529,6 +529,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     };
 
     let t2 = Instant::now();
+    summary.timings.total_s = start.elapsed().as_secs_f64();
     write_designs(task, &graphs, &enumeration, &feasible, &summary, opts)?;
     timings.export_s = t2.elapsed().as_secs_f64();
     timings.total_s = start.elapsed().as_secs_f64();
@@ -606,71 +607,73 @@ fn write_designs(
         fs::remove_dir_all(&dir).map_err(io(&dir))?;
     }
     fs::create_dir_all(&dir).map_err(io(&dir))?;
-    let mut cards = Vec::new();
-    for rec in feasible {
-        let p = prepare(graphs[rec.graph], task, rec.candidate - 1).map_err(SearchError::Export)?;
-        let model = &p.model;
-        let free: Vec<f64> = model
-            .free
-            .iter()
-            .map(|&i| {
-                rec.variables
-                    .get(&model.plan.variables[i].name)
-                    .copied()
-                    .unwrap_or(model.var_bounds(i).0)
-            })
-            .collect();
-        let full = model.full_vars(&free);
-        let modes: Vec<f64> = rec
-            .modes
-            .iter()
-            .map(|m| if m == "up" { 1.0 } else { -1.0 })
-            .collect();
-        let design = Evaluated::new(&model.plan, full.clone(), modes);
-        let pattern = design.pattern(&sample_times(model.t_max, 33));
-        let meta = design_meta(task, model, rec);
-        let all_vars: BTreeMap<String, f64> = model
-            .plan
-            .variables
-            .iter()
-            .zip(&full)
-            .map(|(v, x)| (v.name.clone(), *x))
-            .collect();
-        let constraints: Vec<_> = {
-            let (_, g) = crate::model::compiled::outputs_f64(model, &free, &design.modes);
-            g.iter()
-                .enumerate()
-                .map(|(k, v)| json!({"label": model.constraint_label(k), "value": v}))
-                .collect()
-        };
-        let id = rec.id();
-        let doc = json!({
-            "id": id,
-            "task": task.name,
-            "sequence": rec.sequence,
-            "level": rec.level,
-            "candidate": rec.candidate,
-            "gripping_vertex": rec.gripping_vertex,
-            "modes": rec.modes,
-            "objective": rec.objective,
-            "threshold": model.threshold,
-            "variables": rec.variables,
-            "all_variables": all_vars,
-            "constraint_slack": rec.min_slack,
-            "constraints": constraints,
-            "verification": rec.verification,
-            "self_intersection_free": rec.self_intersection_free,
-            "obstacle_free": rec.obstacle_free,
-            "pattern": pattern,
-            "meta": meta,
-        });
-        let path = dir.join(format!("{id}.json"));
-        fs::write(
-            &path,
-            serde_json::to_string_pretty(&doc).expect("design serializes"),
-        )
-        .map_err(io(&path))?;
-        if opts.export {
+    // Designs are independent: write them in parallel, keep the cards in order.
+    let write_one =
+        |rec: &&AlternativeRecord| -> Result<Option<export::report::ReportDesign>, SearchError> {
+            let model = Model::new(graphs[rec.graph], task, rec.candidate - 1)?;
+            let free: Vec<f64> = model
+                .free
+                .iter()
+                .map(|&i| {
+                    rec.variables
+                        .get(&model.plan.variables[i].name)
+                        .copied()
+                        .unwrap_or(model.var_bounds(i).0)
+                })
+                .collect();
+            let full = model.full_vars(&free);
+            let modes: Vec<f64> = rec
+                .modes
+                .iter()
+                .map(|m| if m == "up" { 1.0 } else { -1.0 })
+                .collect();
+            let design = Evaluated::new(&model.plan, full.clone(), modes);
+            let pattern = design.pattern(&sample_times(model.t_max, 33));
+            let meta = design_meta(task, &model, rec);
+            let all_vars: BTreeMap<String, f64> = model
+                .plan
+                .variables
+                .iter()
+                .zip(&full)
+                .map(|(v, x)| (v.name.clone(), *x))
+                .collect();
+            let constraints: Vec<_> = {
+                let (_, g) = crate::model::compiled::outputs_f64(&model, &free, &design.modes);
+                g.iter()
+                    .enumerate()
+                    .map(|(k, v)| json!({"label": model.constraint_label(k), "value": v}))
+                    .collect()
+            };
+            let id = rec.id();
+            let doc = json!({
+                "id": id,
+                "task": task.name,
+                "sequence": rec.sequence,
+                "level": rec.level,
+                "candidate": rec.candidate,
+                "gripping_vertex": rec.gripping_vertex,
+                "modes": rec.modes,
+                "objective": rec.objective,
+                "threshold": model.threshold,
+                "variables": rec.variables,
+                "all_variables": all_vars,
+                "constraint_slack": rec.min_slack,
+                "constraints": constraints,
+                "verification": rec.verification,
+                "self_intersection_free": rec.self_intersection_free,
+                "obstacle_free": rec.obstacle_free,
+                "pattern": pattern,
+                "meta": meta,
+            });
+            let path = dir.join(format!("{id}.json"));
+            fs::write(
+                &path,
+                serde_json::to_string_pretty(&doc).expect("design serializes"),
+            )
+            .map_err(io(&path))?;
+            if !opts.export {
+                return Ok(None);
+            }
             let out = dir.join(&id);
             let eo = ExportOptions {
                 name: id.clone(),
@@ -683,7 +686,7 @@ fn write_designs(
             if !check.ok {
                 eprintln!("BUG: the exported FOLD file of {id} fails verification");
             }
-            cards.push(export::report::ReportDesign {
+            Ok(Some(export::report::ReportDesign {
                 title: format!(
                     "{} — candidate {} — {}",
                     rec.sequence,
@@ -693,9 +696,22 @@ fn write_designs(
                 meta,
                 files,
                 verify: Some(check),
-            });
-        }
-    }
+            }))
+        };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.jobs)
+        .build()
+        .map_err(|e| SearchError::Export(e.to_string()))?;
+    let cards: Vec<export::report::ReportDesign> = pool
+        .install(|| {
+            feasible
+                .par_iter()
+                .map(write_one)
+                .collect::<Result<Vec<_>, _>>()
+        })?
+        .into_iter()
+        .flatten()
+        .collect();
     if opts.export {
         let input = report_input(task, enumeration, summary, cards);
         export::report::write_report(&opts.out, &input)
@@ -821,8 +837,8 @@ fn report_input(
             counts,
             timings,
             notes: vec![format!(
-                "{} starting points per alternative, seed {}; total {:.1} s wall.",
-                s.settings["starts"], s.settings["seed"], t.total_s
+                "{} starting points per alternative, seed {}, {} workers; the search took {:.1} s wall before writing these files.",
+                s.settings["starts"], s.settings["seed"], s.settings["jobs"], t.total_s
             )],
         },
         tree,
