@@ -56,11 +56,7 @@ fn the_gripper_task_carries_the_thesis_data() {
     assert_eq!(ch.states, 16);
     assert_eq!(ch.cylinders.len(), 1);
     assert_eq!(
-        (
-            ch.cylinders[0].radius,
-            ch.cylinders[0].from,
-            ch.cylinders[0].to
-        ),
+        (ch.cylinders[0].radius, ch.cylinders[0].a, ch.cylinders[0].b),
         (0.25, [0.0, -1.0, 0.5], [0.0, 1.0, 0.5])
     );
 }

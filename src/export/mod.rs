@@ -71,17 +71,8 @@ pub struct TargetPoint {
     pub t: Option<f64>,
 }
 
-/// A cylindrical obstacle: the axis segment from `a` to `b` and a radius.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Cylinder {
-    /// One end of the axis.
-    pub a: [f64; 3],
-    /// The other end of the axis.
-    pub b: [f64; 3],
-    /// Radius (> 0).
-    pub radius: f64,
-}
+/// A cylindrical obstacle (axis segment `a → b`, radius), shared with the checks.
+pub use crate::check::Cylinder;
 
 /// Where a design came from and what it should do; filled by the synthesis stage.
 ///

@@ -171,16 +171,7 @@ fn alternative_seed(seed: u64, key: &str) -> u64 {
 fn obstacles(task: &Task) -> Vec<Cylinder> {
     task.check
         .as_ref()
-        .map(|c| {
-            c.cylinders
-                .iter()
-                .map(|cy| Cylinder {
-                    a: cy.from,
-                    b: cy.to,
-                    radius: cy.radius,
-                })
-                .collect()
-        })
+        .map(|c| c.cylinders.clone())
         .unwrap_or_default()
 }
 
@@ -581,12 +572,7 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
         obstacle: task
             .check
             .as_ref()
-            .and_then(|c| c.cylinders.first())
-            .map(|c| export::Cylinder {
-                a: c.from,
-                b: c.to,
-                radius: c.radius,
-            }),
+            .and_then(|c| c.cylinders.first().copied()),
         second_arm: task.check.as_ref().is_some_and(|c| c.second_arm),
         extra,
     }

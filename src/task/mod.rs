@@ -141,16 +141,9 @@ pub struct CheckSpec {
     pub second_arm: bool,
 }
 
-/// A cylinder obstacle: radius and the segment of its axis.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Cylinder {
-    /// Radius, > 0.
-    pub radius: f64,
-    /// Axis start.
-    pub from: [f64; 3],
-    /// Axis end (different from `from`).
-    pub to: [f64; 3],
-}
+/// A cylinder obstacle (axis segment `a → b` and radius): the checks' own type, so the
+/// task, the intersection check and the pictures share one definition.
+pub use crate::check::Cylinder;
 
 /// Largest N_max accepted: each extension multiplies the number of graphs by roughly
 /// twenty (with all filters: 101 graphs at N_max = 3, 1,929 at 4, 41,549 at 5).
@@ -496,7 +489,11 @@ impl Task {
                             "the axis end equals its start: the axis needs two distinct points",
                         ));
                     }
-                    cylinders.push(Cylinder { radius, from, to });
+                    cylinders.push(Cylinder {
+                        a: from,
+                        b: to,
+                        radius,
+                    });
                 }
                 Some(CheckSpec {
                     states: c.states as usize,
