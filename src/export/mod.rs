@@ -24,7 +24,6 @@
 //! ```
 
 pub mod fold;
-pub mod geom;
 pub mod mesh;
 pub mod plots;
 pub mod render;
@@ -282,7 +281,7 @@ pub fn validate_meta(meta: &DesignMeta, p: &Pattern) -> Result<()> {
                 format!("{} is not allowed; the radius must be > 0", c.radius),
             ));
         }
-        if geom::norm(geom::sub(c.b, c.a)) == 0.0 {
+        if crate::geom::norm(crate::geom::sub(c.b, c.a)) == 0.0 {
             return Err(ExportError::invalid(
                 "meta.obstacle",
                 "the axis ends a and b coincide",

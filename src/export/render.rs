@@ -12,8 +12,8 @@
 
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
 
-use super::geom::{self, V3};
 use super::{DesignMeta, ExportError, Result, validate_meta, validate_pattern};
+use crate::geom::{self, V3};
 use crate::pattern::Pattern;
 
 /// An orthographic camera looking at the origin from a direction given in degrees.
