@@ -88,6 +88,22 @@ fn same_seed_same_results_and_a_resumed_run_matches() {
     assert_eq!(counts(&sc), counts(&sa));
     assert_eq!(records(&c), ra, "resumed run differs");
     assert_eq!(sc["designs"], sa["designs"]);
+
+    // Resuming with another seed would mix two searches: refused.
+    let r = foldsynth(&[
+        "synthesize",
+        GRIPPER,
+        "--n-max",
+        "2",
+        "--out",
+        c.to_str().unwrap(),
+        "--no-export",
+        "--seed",
+        "8",
+        "--resume",
+    ]);
+    assert!(!r.status.success());
+    assert!(String::from_utf8_lossy(&r.stderr).contains("other settings"));
 }
 
 #[test]

@@ -375,6 +375,28 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     }
 
     fs::create_dir_all(&opts.out).map_err(io(&opts.out))?;
+    // The settings that decide the results: a resumed run must use the same ones, or its
+    // records would mix two searches.
+    let settings_path = opts.out.join("settings.json");
+    let settings = json!({
+        "task": task.name, "n_max": n_max, "starts": opts.starts, "seed": opts.seed,
+        "sweep": opts.sweep, "foldsynth": env!("CARGO_PKG_VERSION"),
+    });
+    if opts.resume
+        && let Ok(text) = fs::read_to_string(&settings_path)
+        && let Ok(old) = serde_json::from_str::<serde_json::Value>(&text)
+        && old != settings
+    {
+        return Err(terr(&format!(
+            "--resume: {} was written with other settings ({old}); resume with those, or start afresh without --resume",
+            settings_path.display()
+        )));
+    }
+    fs::write(
+        &settings_path,
+        serde_json::to_string_pretty(&settings).expect("settings serialize"),
+    )
+    .map_err(io(&settings_path))?;
     let jsonl = opts.out.join("alternatives.jsonl");
     let mut done: Vec<AlternativeRecord> = if opts.resume {
         read_records(&jsonl)?
