@@ -84,7 +84,7 @@ fn written_file_has_the_spec_fields() {
                 ]
             })
             .collect();
-        assert!(foldsynth::export::geom::signed_area_2d(&pts) > 0.0);
+        assert!(foldsynth::geom::signed_area_2d(&pts) > 0.0);
     }
     // Folded frames.
     let frames = v["file_frames"].as_array().unwrap();

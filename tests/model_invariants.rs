@@ -243,3 +243,41 @@ fn a_point_that_breaks_eq25_is_not_rigid_and_has_finite_coordinates() {
     assert!(coords.iter().flatten().all(|c| c.is_finite()), "{coords:?}");
     assert!(buf.iter().all(|v| v.is_finite()));
 }
+
+#[test]
+fn crease_rotations_point_along_the_folded_creases() {
+    let task = task();
+    let graph = CreaseGraph::from_sequence(&task, "2, 3, (4, 8), 4, (7, 8)").unwrap();
+    let model = Model::new(&graph, &task, 0).unwrap();
+    let compiled = CompiledModel::new(&model, &Options::default()).unwrap();
+    let modes = vec![1.0, -1.0, 1.0];
+    let problem = ModelProblem::new(&model, &compiled, &modes);
+    let sol = optimize::minimize(
+        &problem,
+        &optimize::Options {
+            starts: 4,
+            ..Default::default()
+        },
+    );
+    assert!(sol.feasible);
+    let design = Evaluated::new(&model.plan, model.full_vars(&sol.x), modes);
+    for t in [0.3, 0.9, std::f64::consts::FRAC_PI_2] {
+        let folded = design.fold(t);
+        let x = design.coords(&folded);
+        for (c, cr) in model.plan.creases.iter().enumerate() {
+            let r = geometry::crease_rotation(&model.plan, &design.flat, &folded, c);
+            let d: Vec<f64> = (0..3).map(|i| x[cr.head][i] - x[cr.tail][i]).collect();
+            let l = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+            for i in 0..3 {
+                assert!((r[i][0] - d[i] / l).abs() < 1e-12, "crease {c} at t = {t}");
+            }
+            // A rotation: orthonormal columns.
+            for a in 0..3 {
+                for b in 0..3 {
+                    let dot: f64 = (0..3).map(|i| r[i][a] * r[i][b]).sum();
+                    assert!((dot - f64::from(u8::from(a == b))).abs() < 1e-12);
+                }
+            }
+        }
+    }
+}

@@ -56,11 +56,7 @@ fn the_gripper_task_carries_the_thesis_data() {
     assert_eq!(ch.states, 16);
     assert_eq!(ch.cylinders.len(), 1);
     assert_eq!(
-        (
-            ch.cylinders[0].radius,
-            ch.cylinders[0].from,
-            ch.cylinders[0].to
-        ),
+        (ch.cylinders[0].radius, ch.cylinders[0].a, ch.cylinders[0].b),
         (0.25, [0.0, -1.0, 0.5], [0.0, 1.0, 0.5])
     );
 }
@@ -340,9 +336,15 @@ fn types_and_structure_of_extendable_vertices_are_checked() {
         &["2 sectors are open", "exactly one open sector"],
     );
     let e = err(&edit("n_max = 3", "n_max = 99"));
-    assert_err(&e, "grammar.n_max", &["allowed 0..="]);
+    assert_err(&e, "grammar.n_max", &["allowed 1..="]);
     let e = err(&edit("n_max = 3", "n_max = -1"));
-    assert_err(&e, "grammar.n_max", &["allowed 0..="]);
+    assert_err(&e, "grammar.n_max", &["allowed 1..="]);
+    let e = err(&edit("n_max = 3", "n_max = 0"));
+    assert_err(
+        &e,
+        "grammar.n_max",
+        &["allowed 1..=", "at least one vertex"],
+    );
 }
 
 #[test]

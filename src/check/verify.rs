@@ -11,6 +11,7 @@
 //!   normals of its two facets;
 //! - rigid foldability over a dense sweep of the motion (the thesis checks t_max only).
 
+use crate::geom;
 use crate::kinematics::{closure_residual, wrap_angle};
 use crate::model::geometry::units;
 use crate::model::numeric::Evaluated;
@@ -129,23 +130,6 @@ impl VerifyReport {
     }
 }
 
-fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-}
-
-/// Unit normal of a polygon by Newell's method (counter-clockwise → +z when flat).
-fn normal(points: &[[f64; 3]]) -> [f64; 3] {
-    let mut n = [0.0; 3];
-    for i in 0..points.len() {
-        let (p, q) = (&points[i], &points[(i + 1) % points.len()]);
-        n[0] += (p[1] - q[1]) * (p[2] + q[2]);
-        n[1] += (p[2] - q[2]) * (p[0] + q[0]);
-        n[2] += (p[0] - q[0]) * (p[1] + q[1]);
-    }
-    let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-    [n[0] / l, n[1] / l, n[2] / l]
-}
-
 /// Verify `design` at the states `ts` (the sweep; the last one is taken as t_max for
 /// the thesis-style check).
 pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyReport {
@@ -225,11 +209,11 @@ pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyRep
             let size = poly
                 .iter()
                 .flat_map(|a| poly.iter().map(move |b| (a, b)))
-                .map(|(a, b)| dist(&flat3[*a], &flat3[*b]))
+                .map(|(a, b)| geom::dist(flat3[*a], flat3[*b]))
                 .fold(0.0, f64::max);
             for (ia, a) in poly.iter().enumerate() {
                 for b in &poly[ia + 1..] {
-                    let e = (dist(&x[*a], &x[*b]) - dist(&flat3[*a], &flat3[*b])).abs()
+                    let e = (geom::dist(x[*a], x[*b]) - geom::dist(flat3[*a], flat3[*b])).abs()
                         / size.max(1e-300);
                     r.isometry_max = r.isometry_max.max(e);
                 }
@@ -245,42 +229,28 @@ pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyRep
                 r.closure_max = r.closure_max.max(closure_residual(&u, &st.phi));
             }
         }
-        // Fold angles against the facets' normals, oriented like the facet in the flat
-        // state (an inverted facet is a layout defect the intersection check reports).
-        let normals: Vec<Option<[f64; 3]>> = plan
+        // Fold angles against the facets' normals (`geom::fold_angle`), each facet's points
+        // ordered so its flat normal is +z (an inverted facet is a layout defect the
+        // intersection check reports, not a wrong fold angle).
+        let facet_points: Vec<Vec<[f64; 3]>> = plan
             .polygons
             .iter()
             .map(|(p, _)| {
-                (p.len() >= 3).then(|| {
-                    let n = normal(&p.iter().map(|v| x[*v]).collect::<Vec<_>>());
-                    let flat_n = normal(&p.iter().map(|v| flat3[*v]).collect::<Vec<_>>());
-                    if flat_n[2] < 0.0 {
-                        [-n[0], -n[1], -n[2]]
-                    } else {
-                        n
-                    }
-                })
+                let mut pts: Vec<[f64; 3]> = p.iter().map(|v| x[*v]).collect();
+                if geom::newell_normal(&p.iter().map(|v| flat3[*v]).collect::<Vec<_>>())[2] < 0.0 {
+                    pts.reverse();
+                }
+                pts
             })
             .collect();
         for (ci, c) in plan.creases.iter().enumerate() {
-            let (Some(nl), Some(nr)) = (normals[c.left], normals[c.right]) else {
+            let (l, rt) = (&facet_points[c.left], &facet_points[c.right]);
+            if l.len() < 3 || rt.len() < 3 {
                 continue;
-            };
-            let e = {
-                let (p, q) = (&x[c.tail], &x[c.head]);
-                let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
-                let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                [d[0] / l, d[1] / l, d[2] / l]
-            };
-            let cross = [
-                nr[1] * nl[2] - nr[2] * nl[1],
-                nr[2] * nl[0] - nr[0] * nl[2],
-                nr[0] * nl[1] - nr[1] * nl[0],
-            ];
-            let geo = (cross[0] * e[0] + cross[1] * e[1] + cross[2] * e[2])
-                .atan2(nr[0] * nl[0] + nr[1] * nl[1] + nr[2] * nl[2]);
-            let err = wrap_angle(geo - folded.rho[ci]).abs();
-            r.fold_angle_max = r.fold_angle_max.max(err);
+            }
+            if let Some(geo) = geom::fold_angle(x[c.tail], x[c.head], l, rt) {
+                r.fold_angle_max = r.fold_angle_max.max(wrap_angle(geo - folded.rho[ci]).abs());
+            }
         }
     }
     r

@@ -27,12 +27,16 @@ pub enum BenchCommand {
     /// One vertex: value+gradient of φ1+φ2+φ3 by JIT, interpreter, f64 + central
     /// differences and dual numbers, and the compile latency.
     Vertex(VertexBenchArgs),
+    /// One design model: objective and constraints with gradients by JIT, interpreter and
+    /// f64 + central differences, and the compile latency.
+    Model(super::bench_model::ModelBenchArgs),
 }
 
 /// Run `foldsynth bench`.
 pub fn run(args: BenchArgs) -> Result<()> {
     match args.what {
         BenchCommand::Vertex(a) => run_vertex(a),
+        BenchCommand::Model(a) => super::bench_model::run(a),
     }
 }
 
@@ -73,7 +77,7 @@ pub struct VertexBenchArgs {
 }
 
 /// Median nanoseconds per call of `f`, over batches filling about `budget`.
-fn time_ns(budget: Duration, mut f: impl FnMut()) -> f64 {
+pub(crate) fn time_ns(budget: Duration, mut f: impl FnMut()) -> f64 {
     // Calibrate: how many calls take ~1/20 of the budget.
     let target = budget / 20;
     let mut n = 1usize;
@@ -104,7 +108,7 @@ fn time_ns(budget: Duration, mut f: impl FnMut()) -> f64 {
 }
 
 /// Median of `reps` runs of `f` in milliseconds.
-fn time_ms<T>(reps: usize, mut f: impl FnMut() -> T) -> (f64, T) {
+pub(crate) fn time_ms<T>(reps: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     let mut times = Vec::new();
     let mut last = None;
     for _ in 0..reps {

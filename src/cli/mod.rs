@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod bench;
+pub mod bench_model;
 pub mod enumerate;
 pub mod export;
 pub mod formulas;

@@ -246,20 +246,12 @@ impl CompiledFn {
     /// Evaluate into `out` after checking every length.
     #[inline]
     pub fn call(&self, vars: &[f64], params: &[f64], out: &mut [f64]) -> Result<(), ShapeError> {
-        let chk = |what, expected: usize, got: usize| {
-            if expected == got {
-                Ok(())
-            } else {
-                Err(ShapeError::Length {
-                    what,
-                    expected,
-                    got,
-                })
-            }
-        };
-        chk("vars", self.n_vars, vars.len())?;
-        chk("params", self.n_params, params.len())?;
-        chk("out", self.n_outputs, out.len())?;
+        ShapeError::check_lengths(
+            [self.n_vars, self.n_params, self.n_outputs],
+            vars,
+            params,
+            out,
+        )?;
         // SAFETY: lengths checked; the code reads n_vars/n_params and writes n_outputs f64s.
         unsafe { (self.func)(vars.as_ptr(), params.as_ptr(), out.as_mut_ptr()) };
         Ok(())

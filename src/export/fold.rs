@@ -39,7 +39,8 @@ use std::path::Path;
 
 use serde_json::{Map, Value, json};
 
-use super::{DesignMeta, ExportError, FoldSpec, geom, validate_meta, validate_pattern};
+use super::{DesignMeta, ExportError, FoldSpec, validate_meta, validate_pattern};
+use crate::geom;
 use crate::pattern::{Edge, EdgeKind, Frame, Pattern};
 
 /// An error reading a FOLD file: which file, which field, what is wrong.

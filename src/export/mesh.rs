@@ -7,8 +7,8 @@
 
 use std::fmt::Write as _;
 
-use super::geom::{self, V3};
 use super::{ExportError, Result, validate_pattern};
+use crate::geom::{self, V3};
 use crate::pattern::Pattern;
 
 /// A triangle mesh of one state; `arm` tells which copy each triangle belongs to.
@@ -28,10 +28,9 @@ pub struct StateMesh {
 pub fn triangulate_faces(p: &Pattern) -> Result<Vec<[usize; 3]>> {
     let mut out = Vec::new();
     for (fi, f) in p.faces.iter().enumerate() {
-        let poly: Vec<[f64; 2]> = f.iter().map(|&v| p.vertices[v]).collect();
-        let tris = geom::triangulate(&poly)
-            .map_err(|m| ExportError::invalid(format!("pattern.faces[{fi}]"), m))?;
-        out.extend(tris.iter().map(|t| [f[t[0]], f[t[1]], f[t[2]]]));
+        let tris = crate::check::triangulate_polygon(&p.vertices, f, fi)
+            .map_err(|e| ExportError::invalid(format!("pattern.faces[{fi}]"), e.to_string()))?;
+        out.extend(tris);
     }
     Ok(out)
 }

@@ -24,7 +24,6 @@
 //! ```
 
 pub mod fold;
-pub mod geom;
 pub mod mesh;
 pub mod plots;
 pub mod render;
@@ -71,17 +70,8 @@ pub struct TargetPoint {
     pub t: Option<f64>,
 }
 
-/// A cylindrical obstacle: the axis segment from `a` to `b` and a radius.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Cylinder {
-    /// One end of the axis.
-    pub a: [f64; 3],
-    /// The other end of the axis.
-    pub b: [f64; 3],
-    /// Radius (> 0).
-    pub radius: f64,
-}
+/// A cylindrical obstacle (axis segment `a → b`, radius), shared with the checks.
+pub use crate::check::Cylinder;
 
 /// Where a design came from and what it should do; filled by the synthesis stage.
 ///
@@ -291,7 +281,7 @@ pub fn validate_meta(meta: &DesignMeta, p: &Pattern) -> Result<()> {
                 format!("{} is not allowed; the radius must be > 0", c.radius),
             ));
         }
-        if geom::norm(geom::sub(c.b, c.a)) == 0.0 {
+        if crate::geom::norm(crate::geom::sub(c.b, c.a)) == 0.0 {
             return Err(ExportError::invalid(
                 "meta.obstacle",
                 "the axis ends a and b coincide",
@@ -484,8 +474,10 @@ pub fn write_all(
 /// `pattern` is [`Pattern`] as serde writes it (`vertices`, `edges` with
 /// `{"v": [i, j], "kind": "boundary" | {"crease": {"driven": bool}}}`, `faces`, `frames`
 /// with `t`, `coords`, `fold_angles` in radians); `meta` is [`DesignMeta`].
+///
+/// Other keys are allowed and ignored: `foldsynth synthesize` writes its designs
+/// (`OUT/designs/<id>.json`) as such files with the optimization's figures beside them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct DesignFile {
     /// The crease pattern and its folded states.
     pub pattern: Pattern,

@@ -12,8 +12,8 @@
 
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
 
-use super::geom::{self, V3};
 use super::{DesignMeta, ExportError, Result, validate_meta, validate_pattern};
+use crate::geom::{self, V3};
 use crate::pattern::Pattern;
 
 /// An orthographic camera looking at the origin from a direction given in degrees.
@@ -495,7 +495,7 @@ impl<'a> Scene<'a> {
             // Opaque white background: premultiplied RGBA equals straight RGBA here.
             let mut rgba = pm.take();
             let mut frame =
-                gif::Frame::from_rgba_speed(size.0 as u16, size.1 as u16, &mut rgba, 10);
+                gif::Frame::from_rgba_speed(size.0 as u16, size.1 as u16, &mut rgba, 30);
             frame.delay = if k + 1 == n {
                 delay_cs.saturating_mul(8).max(50)
             } else {

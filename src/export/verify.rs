@@ -24,7 +24,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::fold::{Assignment, EdgeFaces, FoldError, FoldFile};
-use super::geom;
+use crate::geom;
 
 /// Tolerances of [`verify`].
 #[derive(Clone, Copy, Debug)]

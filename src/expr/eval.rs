@@ -33,6 +33,31 @@ pub enum ShapeError {
     Output(usize),
 }
 
+impl ShapeError {
+    /// Check the lengths of a call's buffers against `[n_vars, n_params, n_outputs]`.
+    pub fn check_lengths(
+        expected: [usize; 3],
+        vars: &[f64],
+        params: &[f64],
+        out: &[f64],
+    ) -> Result<(), ShapeError> {
+        for (what, expected, got) in [
+            ("vars", expected[0], vars.len()),
+            ("params", expected[1], params.len()),
+            ("out", expected[2], out.len()),
+        ] {
+            if expected != got {
+                return Err(ShapeError::Length {
+                    what,
+                    expected,
+                    got,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
 /// One tape instruction; operands are slot indices (slot `k` holds instruction `k`).
 #[derive(Clone, Copy, Debug)]
 enum Instr {
@@ -175,20 +200,12 @@ impl Tape {
     }
 
     fn check(&self, vars: &[f64], params: &[f64], out: &[f64]) -> Result<(), ShapeError> {
-        let chk = |what, expected: usize, got: usize| {
-            if expected == got {
-                Ok(())
-            } else {
-                Err(ShapeError::Length {
-                    what,
-                    expected,
-                    got,
-                })
-            }
-        };
-        chk("vars", self.n_vars, vars.len())?;
-        chk("params", self.n_params, params.len())?;
-        chk("out", self.outputs.len(), out.len())
+        ShapeError::check_lengths(
+            [self.n_vars, self.n_params, self.outputs.len()],
+            vars,
+            params,
+            out,
+        )
     }
 
     /// Evaluate into `out`, allocating scratch space.

@@ -275,3 +275,27 @@ pub fn position_on<S: Scalar>(flat: &Flat<S>, folded: &Folded<S>, v: usize, f: u
     ];
     linalg::add(&linalg::apply(&folded.rot[f], &x), &folded.trans[f])
 }
+
+/// The global rotation of crease `c` (thesis Eq. 30 and below): the rotation taking the
+/// crease's local frame — x along the crease from its tail, z the paper's normal — to the
+/// folded state, so that `X_head = X_tail + l · R · e_x`. It is the map of the facet right
+/// of the crease composed with the crease's in-plane direction.
+pub fn crease_rotation<S: Scalar>(
+    plan: &Plan,
+    flat: &Flat<S>,
+    folded: &Folded<S>,
+    c: usize,
+) -> Mat3<S> {
+    let cr = &plan.creases[c];
+    let (p, q) = (&flat.pos[cr.tail], &flat.pos[cr.head]);
+    let (dx, dy) = (q[0].clone() - p[0].clone(), q[1].clone() - p[1].clone());
+    let l = (dx.clone() * dx.clone() + dy.clone() * dy.clone()).sqrt();
+    let (c0, s0) = (dx / l.clone(), dy / l);
+    let z = S::from_f64(0.0);
+    let local = [
+        [c0.clone(), -s0.clone(), z.clone()],
+        [s0, c0, z.clone()],
+        [z.clone(), z, S::from_f64(1.0)],
+    ];
+    linalg::mul(&folded.rot[cr.right], &local)
+}

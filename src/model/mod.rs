@@ -20,18 +20,7 @@ use crate::kinematics::Scalar;
 use crate::task::Task;
 use geometry::{Flat, Folded};
 
-/// Variable bounds of a task (Eq. 31–32).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Bounds {
-    /// Shortest crease.
-    pub l_min: f64,
-    /// Longest crease.
-    pub l_max: f64,
-    /// Smallest sector angle (radians).
-    pub alpha_min: f64,
-    /// Largest sector angle (radians).
-    pub alpha_max: f64,
-}
+pub use crate::task::Bounds;
 
 /// A point the gripping vertex should reach at parameter `t`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,16 +97,9 @@ impl Model {
             task: task.name.clone(),
             message: message.to_string(),
         };
-        let b = task
+        let bounds = task
             .bounds
-            .as_ref()
             .ok_or_else(|| err("the task has no [bounds] (l_min, l_max, alpha_min, alpha_max)"))?;
-        let bounds = Bounds {
-            l_min: b.l_min,
-            l_max: b.l_max,
-            alpha_min: b.alpha_min,
-            alpha_max: b.alpha_max,
-        };
         let t_max = task
             .motion
             .as_ref()

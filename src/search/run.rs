@@ -171,16 +171,7 @@ fn alternative_seed(seed: u64, key: &str) -> u64 {
 fn obstacles(task: &Task) -> Vec<Cylinder> {
     task.check
         .as_ref()
-        .map(|c| {
-            c.cylinders
-                .iter()
-                .map(|cy| Cylinder {
-                    a: cy.from,
-                    b: cy.to,
-                    radius: cy.radius,
-                })
-                .collect()
-        })
+        .map(|c| c.cylinders.clone())
         .unwrap_or_default()
 }
 
@@ -384,6 +375,28 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     }
 
     fs::create_dir_all(&opts.out).map_err(io(&opts.out))?;
+    // The settings that decide the results: a resumed run must use the same ones, or its
+    // records would mix two searches.
+    let settings_path = opts.out.join("settings.json");
+    let settings = json!({
+        "task": task.name, "n_max": n_max, "starts": opts.starts, "seed": opts.seed,
+        "sweep": opts.sweep, "foldsynth": env!("CARGO_PKG_VERSION"),
+    });
+    if opts.resume
+        && let Ok(text) = fs::read_to_string(&settings_path)
+        && let Ok(old) = serde_json::from_str::<serde_json::Value>(&text)
+        && old != settings
+    {
+        return Err(terr(&format!(
+            "--resume: {} was written with other settings ({old}); resume with those, or start afresh without --resume",
+            settings_path.display()
+        )));
+    }
+    fs::write(
+        &settings_path,
+        serde_json::to_string_pretty(&settings).expect("settings serialize"),
+    )
+    .map_err(io(&settings_path))?;
     let jsonl = opts.out.join("alternatives.jsonl");
     let mut done: Vec<AlternativeRecord> = if opts.resume {
         read_records(&jsonl)?
@@ -529,6 +542,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     };
 
     let t2 = Instant::now();
+    summary.timings.total_s = start.elapsed().as_secs_f64();
     write_designs(task, &graphs, &enumeration, &feasible, &summary, opts)?;
     timings.export_s = t2.elapsed().as_secs_f64();
     timings.total_s = start.elapsed().as_secs_f64();
@@ -580,12 +594,7 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
         obstacle: task
             .check
             .as_ref()
-            .and_then(|c| c.cylinders.first())
-            .map(|c| export::Cylinder {
-                a: c.from,
-                b: c.to,
-                radius: c.radius,
-            }),
+            .and_then(|c| c.cylinders.first().copied()),
         second_arm: task.check.as_ref().is_some_and(|c| c.second_arm),
         extra,
     }
@@ -606,71 +615,73 @@ fn write_designs(
         fs::remove_dir_all(&dir).map_err(io(&dir))?;
     }
     fs::create_dir_all(&dir).map_err(io(&dir))?;
-    let mut cards = Vec::new();
-    for rec in feasible {
-        let p = prepare(graphs[rec.graph], task, rec.candidate - 1).map_err(SearchError::Export)?;
-        let model = &p.model;
-        let free: Vec<f64> = model
-            .free
-            .iter()
-            .map(|&i| {
-                rec.variables
-                    .get(&model.plan.variables[i].name)
-                    .copied()
-                    .unwrap_or(model.var_bounds(i).0)
-            })
-            .collect();
-        let full = model.full_vars(&free);
-        let modes: Vec<f64> = rec
-            .modes
-            .iter()
-            .map(|m| if m == "up" { 1.0 } else { -1.0 })
-            .collect();
-        let design = Evaluated::new(&model.plan, full.clone(), modes);
-        let pattern = design.pattern(&sample_times(model.t_max, 33));
-        let meta = design_meta(task, model, rec);
-        let all_vars: BTreeMap<String, f64> = model
-            .plan
-            .variables
-            .iter()
-            .zip(&full)
-            .map(|(v, x)| (v.name.clone(), *x))
-            .collect();
-        let constraints: Vec<_> = {
-            let (_, g) = crate::model::compiled::outputs_f64(model, &free, &design.modes);
-            g.iter()
-                .enumerate()
-                .map(|(k, v)| json!({"label": model.constraint_label(k), "value": v}))
-                .collect()
-        };
-        let id = rec.id();
-        let doc = json!({
-            "id": id,
-            "task": task.name,
-            "sequence": rec.sequence,
-            "level": rec.level,
-            "candidate": rec.candidate,
-            "gripping_vertex": rec.gripping_vertex,
-            "modes": rec.modes,
-            "objective": rec.objective,
-            "threshold": model.threshold,
-            "variables": rec.variables,
-            "all_variables": all_vars,
-            "constraint_slack": rec.min_slack,
-            "constraints": constraints,
-            "verification": rec.verification,
-            "self_intersection_free": rec.self_intersection_free,
-            "obstacle_free": rec.obstacle_free,
-            "pattern": pattern,
-            "meta": meta,
-        });
-        let path = dir.join(format!("{id}.json"));
-        fs::write(
-            &path,
-            serde_json::to_string_pretty(&doc).expect("design serializes"),
-        )
-        .map_err(io(&path))?;
-        if opts.export {
+    // Designs are independent: write them in parallel, keep the cards in order.
+    let write_one =
+        |rec: &&AlternativeRecord| -> Result<Option<export::report::ReportDesign>, SearchError> {
+            let model = Model::new(graphs[rec.graph], task, rec.candidate - 1)?;
+            let free: Vec<f64> = model
+                .free
+                .iter()
+                .map(|&i| {
+                    rec.variables
+                        .get(&model.plan.variables[i].name)
+                        .copied()
+                        .unwrap_or(model.var_bounds(i).0)
+                })
+                .collect();
+            let full = model.full_vars(&free);
+            let modes: Vec<f64> = rec
+                .modes
+                .iter()
+                .map(|m| if m == "up" { 1.0 } else { -1.0 })
+                .collect();
+            let design = Evaluated::new(&model.plan, full.clone(), modes);
+            let pattern = design.pattern(&sample_times(model.t_max, 33));
+            let meta = design_meta(task, &model, rec);
+            let all_vars: BTreeMap<String, f64> = model
+                .plan
+                .variables
+                .iter()
+                .zip(&full)
+                .map(|(v, x)| (v.name.clone(), *x))
+                .collect();
+            let constraints: Vec<_> = {
+                let (_, g) = crate::model::compiled::outputs_f64(&model, &free, &design.modes);
+                g.iter()
+                    .enumerate()
+                    .map(|(k, v)| json!({"label": model.constraint_label(k), "value": v}))
+                    .collect()
+            };
+            let id = rec.id();
+            let doc = json!({
+                "id": id,
+                "task": task.name,
+                "sequence": rec.sequence,
+                "level": rec.level,
+                "candidate": rec.candidate,
+                "gripping_vertex": rec.gripping_vertex,
+                "modes": rec.modes,
+                "objective": rec.objective,
+                "threshold": model.threshold,
+                "variables": rec.variables,
+                "all_variables": all_vars,
+                "constraint_slack": rec.min_slack,
+                "constraints": constraints,
+                "verification": rec.verification,
+                "self_intersection_free": rec.self_intersection_free,
+                "obstacle_free": rec.obstacle_free,
+                "pattern": pattern,
+                "meta": meta,
+            });
+            let path = dir.join(format!("{id}.json"));
+            fs::write(
+                &path,
+                serde_json::to_string_pretty(&doc).expect("design serializes"),
+            )
+            .map_err(io(&path))?;
+            if !opts.export {
+                return Ok(None);
+            }
             let out = dir.join(&id);
             let eo = ExportOptions {
                 name: id.clone(),
@@ -683,7 +694,7 @@ fn write_designs(
             if !check.ok {
                 eprintln!("BUG: the exported FOLD file of {id} fails verification");
             }
-            cards.push(export::report::ReportDesign {
+            Ok(Some(export::report::ReportDesign {
                 title: format!(
                     "{} — candidate {} — {}",
                     rec.sequence,
@@ -693,9 +704,22 @@ fn write_designs(
                 meta,
                 files,
                 verify: Some(check),
-            });
-        }
-    }
+            }))
+        };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.jobs)
+        .build()
+        .map_err(|e| SearchError::Export(e.to_string()))?;
+    let cards: Vec<export::report::ReportDesign> = pool
+        .install(|| {
+            feasible
+                .par_iter()
+                .map(write_one)
+                .collect::<Result<Vec<_>, _>>()
+        })?
+        .into_iter()
+        .flatten()
+        .collect();
     if opts.export {
         let input = report_input(task, enumeration, summary, cards);
         export::report::write_report(&opts.out, &input)
@@ -821,8 +845,8 @@ fn report_input(
             counts,
             timings,
             notes: vec![format!(
-                "{} starting points per alternative, seed {}; total {:.1} s wall.",
-                s.settings["starts"], s.settings["seed"], t.total_s
+                "{} starting points per alternative, seed {}, {} workers; the search took {:.1} s wall before writing these files.",
+                s.settings["starts"], s.settings["seed"], s.settings["jobs"], t.total_s
             )],
         },
         tree,

@@ -141,16 +141,9 @@ pub struct CheckSpec {
     pub second_arm: bool,
 }
 
-/// A cylinder obstacle: radius and the segment of its axis.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Cylinder {
-    /// Radius, > 0.
-    pub radius: f64,
-    /// Axis start.
-    pub from: [f64; 3],
-    /// Axis end (different from `from`).
-    pub to: [f64; 3],
-}
+/// A cylinder obstacle (axis segment `a → b` and radius): the checks' own type, so the
+/// task, the intersection check and the pictures share one definition.
+pub use crate::check::Cylinder;
 
 /// Largest N_max accepted: each extension multiplies the number of graphs by roughly
 /// twenty (with all filters: 101 graphs at N_max = 3, 1,929 at 4, 41,549 at 5).
@@ -339,11 +332,11 @@ impl Task {
         let raw: RawTask = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
 
         let n_max = raw.grammar.n_max;
-        if !(0..=N_MAX_LIMIT as i64).contains(&n_max) {
+        if !(1..=N_MAX_LIMIT as i64).contains(&n_max) {
             return Err(cx.err(
                 "grammar.n_max",
                 format!(
-                    "{n_max} is out of range: allowed 0..={N_MAX_LIMIT} (the number of graphs grows about twentyfold per internal vertex)"
+                    "{n_max} is out of range: allowed 1..={N_MAX_LIMIT} (at least one vertex to extend; the number of graphs grows about twentyfold per internal vertex)"
                 ),
             ));
         }
@@ -496,7 +489,11 @@ impl Task {
                             "the axis end equals its start: the axis needs two distinct points",
                         ));
                     }
-                    cylinders.push(Cylinder { radius, from, to });
+                    cylinders.push(Cylinder {
+                        a: from,
+                        b: to,
+                        radius,
+                    });
                 }
                 Some(CheckSpec {
                     states: c.states as usize,

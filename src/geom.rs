@@ -1,5 +1,6 @@
-//! Small geometry kernel for the export stage: vectors, face normals, signed fold angles,
-//! corner angles, ear-clipping triangulation, and faces of a planar straight-line graph.
+//! Small geometry kernel shared by verification, export and FOLD reading: vectors, face
+//! normals, signed fold angles, corner angles, and faces of a planar straight-line graph.
+//! (Facet triangulation lives with the intersection checks, `check::triangulate`.)
 //!
 //! ## The fold-angle sign
 //!
@@ -129,83 +130,6 @@ pub fn rotate(p: V3, axis: V3, angle: f64) -> V3 {
         p[1] * c + kxp[1] * s + axis[1] * kdp * (1.0 - c),
         p[2] * c + kxp[2] * s + axis[2] * kdp * (1.0 - c),
     ]
-}
-
-fn cross2(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-}
-
-/// Ear-clipping triangulation of a simple polygon given counter-clockwise in 2D.
-/// Returns index triples into `poly`, each counter-clockwise. Collinear vertices are kept
-/// as triangle corners where possible; zero-area remainders are dropped.
-pub fn triangulate(poly: &[[f64; 2]]) -> Result<Vec<[usize; 3]>, String> {
-    let n = poly.len();
-    if n < 3 {
-        return Err(format!("a polygon needs 3 vertices, got {n}"));
-    }
-    let area = signed_area_2d(poly);
-    if area <= 0.0 {
-        return Err(format!(
-            "polygon is not counter-clockwise (signed area {area})"
-        ));
-    }
-    // Scale-aware tolerance for "strictly convex": relative to the squared size.
-    let size = poly
-        .iter()
-        .flat_map(|p| poly.iter().map(move |q| (p[0] - q[0]).hypot(p[1] - q[1])))
-        .fold(0.0, f64::max);
-    let eps = 1e-12 * size * size;
-    let mut idx: Vec<usize> = (0..n).collect();
-    let mut tris = Vec::with_capacity(n - 2);
-    while idx.len() > 3 {
-        let m = idx.len();
-        let mut clipped = false;
-        for i in 0..m {
-            let (ip, ic, inx) = (idx[(i + m - 1) % m], idx[i], idx[(i + 1) % m]);
-            let (a, b, c) = (poly[ip], poly[ic], poly[inx]);
-            if cross2(a, b, c) <= eps {
-                continue; // reflex or collinear: not an ear
-            }
-            let blocked = idx.iter().any(|&j| {
-                if j == ip || j == ic || j == inx {
-                    return false;
-                }
-                let p = poly[j];
-                // Inside or on the boundary of the candidate triangle blocks the ear.
-                cross2(a, b, p) >= -eps && cross2(b, c, p) >= -eps && cross2(c, a, p) >= -eps
-            });
-            if !blocked {
-                tris.push([ip, ic, inx]);
-                idx.remove(i);
-                clipped = true;
-                break;
-            }
-        }
-        if !clipped {
-            // Only collinear vertices left to remove (zero-area strip), or not simple.
-            let m = idx.len();
-            let k = (0..m).find(|&i| {
-                let (a, b, c) = (
-                    poly[idx[(i + m - 1) % m]],
-                    poly[idx[i]],
-                    poly[idx[(i + 1) % m]],
-                );
-                cross2(a, b, c).abs() <= eps
-            });
-            match k {
-                Some(i) => {
-                    idx.remove(i);
-                }
-                None => {
-                    return Err("polygon is not simple (no ear found)".into());
-                }
-            }
-        }
-    }
-    if cross2(poly[idx[0]], poly[idx[1]], poly[idx[2]]) > eps {
-        tris.push([idx[0], idx[1], idx[2]]);
-    }
-    Ok(tris)
 }
 
 /// Faces of a planar straight-line graph: every bounded face, counter-clockwise, found by
@@ -378,49 +302,6 @@ mod tests {
         let sum: f64 = angles.iter().sum();
         assert!((sum - 4.0 * PI).abs() < 1e-12);
         assert!((angles[3] - 1.5 * PI).abs() < 1e-12);
-    }
-
-    fn tri_area(poly: &[[f64; 2]], t: &[usize; 3]) -> f64 {
-        signed_area_2d(&[poly[t[0]], poly[t[1]], poly[t[2]]])
-    }
-
-    #[test]
-    fn ear_clipping_covers_the_polygon() {
-        let polys: Vec<Vec<[f64; 2]>> = vec![
-            vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
-            vec![
-                [0.0, 0.0],
-                [2.0, 0.0],
-                [2.0, 1.0],
-                [1.0, 1.0],
-                [1.0, 2.0],
-                [0.0, 2.0],
-            ],
-            // A comb with two notches.
-            vec![
-                [0.0, 0.0],
-                [5.0, 0.0],
-                [5.0, 3.0],
-                [4.0, 3.0],
-                [4.0, 1.0],
-                [3.0, 1.0],
-                [3.0, 3.0],
-                [2.0, 3.0],
-                [2.0, 1.0],
-                [1.0, 1.0],
-                [1.0, 3.0],
-                [0.0, 3.0],
-            ],
-            // Collinear vertices on a side (a crease ending on the side of a face).
-            vec![[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]],
-        ];
-        for poly in polys {
-            let tris = triangulate(&poly).unwrap();
-            let total: f64 = tris.iter().map(|t| tri_area(&poly, t)).sum();
-            assert!((total - signed_area_2d(&poly)).abs() < 1e-12);
-            assert!(tris.iter().all(|t| tri_area(&poly, t) > 0.0));
-        }
-        assert!(triangulate(&[[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]]).is_err());
     }
 
     #[test]
