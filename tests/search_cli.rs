@@ -1,7 +1,8 @@
 //! `foldsynth synthesize` end to end on the gripper task with N_max = 2 (66 alternatives):
 //! same seed, same results (whatever the number of workers); a run killed halfway and
-//! resumed gives the same results; every exported FOLD file passes `foldsynth verify`;
-//! bad task files are clear errors.
+//! resumed gives the same results; every exported FOLD file passes `foldsynth verify` and
+//! folds, in the bar-and-hinge simulation, onto the PTU's states; bad task files are clear
+//! errors.
 
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -131,7 +132,45 @@ fn exported_designs_verify_and_the_report_exists() {
             "{id}: {}",
             String::from_utf8_lossy(&r.stdout)
         );
+        // The FOLD file, simulated by the bar-and-hinge model from its own frames, folds
+        // rigidly onto the PTU's states.
+        let r = foldsynth(&["simulate", fold.to_str().unwrap(), "--json"]);
+        assert!(
+            r.status.success(),
+            "{id}: {}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+        let sim: Value = serde_json::from_slice(&r.stdout).unwrap();
+        assert_eq!(sim["agrees_with_ptu"], true, "{id}: {sim}");
     }
+    // Every design at once, from the output directory (issue 8's cross-validation).
+    let r = foldsynth(&["simulate", "--crossval", out.to_str().unwrap(), "--json"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let cv: Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert_eq!(cv["count"].as_u64().unwrap() as usize, designs.len());
+    assert_eq!(cv["agree"], cv["count"]);
+    assert!(cv["max_gamma"].as_f64().unwrap() <= 1e-8);
+    assert!(cv["max_position_error"].as_f64().unwrap() <= 1e-7);
+    // The numeric benchmark takes a design file and measures the same motion both ways.
+    let first = out
+        .join("designs")
+        .join(format!("{}.json", designs[0].as_str().unwrap()));
+    let r = foldsynth(&[
+        "bench",
+        "numeric",
+        first.to_str().unwrap(),
+        "--task",
+        GRIPPER,
+        "--millis",
+        "10",
+        "--steps",
+        "8",
+        "--json",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let b: Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert!(b["jit_vs_f64_max"].as_f64().unwrap() <= 1e-12, "{b}");
+    assert!(b["sim_panels_end_gap"].as_f64().unwrap() <= 1e-7, "{b}");
 }
 
 #[test]

@@ -247,6 +247,85 @@ fn missing_file_and_bad_flags_fail_cleanly() {
     assert!(!out.status.success());
 }
 
+/// Design JSON, FOLD, `--crossval` and `bench numeric` inputs that are wrong: a non-zero
+/// exit, the file and what is wrong named, never a panic.
+#[test]
+fn bad_design_inputs_fail_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, body: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, body).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["simulate".into(), write("a.json", "{\"id\": 3}")],
+            "not a design file",
+        ),
+        (
+            vec!["simulate".into(), write("b.json", "not json")],
+            "not valid JSON",
+        ),
+        (vec!["simulate".into(), write("c.fold", "{}")], "c.fold"),
+        (
+            vec![
+                "simulate".into(),
+                "--crossval".into(),
+                dir.path().join("none").display().to_string(),
+            ],
+            "cannot read the directory",
+        ),
+        (
+            vec![
+                "simulate".into(),
+                "grammar/flasher_adapted.toml".into(),
+                "--angle".into(),
+                "t".into(),
+            ],
+            "are for FOLD and design files",
+        ),
+        (
+            vec![
+                "bench".into(),
+                "numeric".into(),
+                write("d.json", "{\"task\": \"gripper\"}"),
+                "--task".into(),
+                "grammar/gripper.toml".into(),
+            ],
+            "field 'sequence' is missing",
+        ),
+        (
+            vec![
+                "bench".into(),
+                "numeric".into(),
+                write("e.json", "{\"task\": \"nosuchtask\"}"),
+            ],
+            "give the task file with --task",
+        ),
+        (
+            vec![
+                "bench".into(),
+                "numeric".into(),
+                "grammar/gripper.toml".into(),
+                "--task".into(),
+                "grammar/gripper.toml".into(),
+            ],
+            "--task is for a design JSON",
+        ),
+    ];
+    for (args, expect) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let out = foldsynth(&args);
+        let err = text(&out.stderr);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(
+            err.contains(expect),
+            "{args:?}: expected '{expect}' in: {err}"
+        );
+    }
+}
+
 #[test]
 fn optimize_flasher_is_deterministic_for_a_seed() {
     let run = || {

@@ -175,14 +175,18 @@ impl Checker {
                 directed.insert((p, q), f);
             }
         }
-        let witness = |f: usize, p: usize, q: usize| {
+        // The vertex of facet `f` farthest from the line p → q on the facet's own side
+        // (`side` = +1 left, −1 right). Signed, because a non-convex facet can reach
+        // farther on the other side of its crease: a witness there makes the flat fold
+        // angle ±π instead of 0, and the flip test then fires (or misses) at random.
+        let witness = |f: usize, p: usize, q: usize, side: f64| {
             let (a, b) = (layout[p], layout[q]);
             let (ex, ey) = (b[0] - a[0], b[1] - a[1]);
-            let dist = |v: usize| ((layout[v][0] - a[0]) * ey - (layout[v][1] - a[1]) * ex).abs();
+            let left = |v: usize| side * (ex * (layout[v][1] - a[1]) - ey * (layout[v][0] - a[0]));
             faces[f]
                 .iter()
                 .copied()
-                .max_by(|&x, &y| dist(x).total_cmp(&dist(y)))
+                .max_by(|&x, &y| left(x).total_cmp(&left(y)))
                 .unwrap_or(p)
         };
         let mut hinges: Vec<Hinge> = directed
@@ -194,8 +198,8 @@ impl Checker {
                     face_b: fb,
                     p,
                     q,
-                    witness_a: witness(fa, p, q),
-                    witness_b: witness(fb, p, q),
+                    witness_a: witness(fa, p, q, 1.0),
+                    witness_b: witness(fb, p, q, -1.0),
                 })
             })
             .collect();
@@ -448,6 +452,55 @@ mod tests {
             [-1.0, 0.0],
         ];
         Checker::new(&layout, &[vec![0, 1, 2, 3], vec![0, 3, 4, 5]]).unwrap()
+    }
+
+    /// A non-convex facet whose farthest corner lies across the line of its crease: the
+    /// fold angle must still be the rotation about the crease, 0 when flat, and the
+    /// exactly flat start must not count as a flip.
+    #[test]
+    fn non_convex_facet_reaching_across_its_crease() {
+        let layout = [
+            [0.0, 0.0],
+            [1.0, 0.0],
+            [1.0, 1.0],
+            [0.0, 1.0],
+            [3.0, 1.5],
+            [-1.0, 2.0],
+            [-1.0, 0.0],
+        ];
+        let faces = [vec![0, 1, 2, 3], vec![0, 3, 4, 5, 6]];
+        let c = Checker::new(&layout, &faces).unwrap();
+        assert_eq!(c.hinges().len(), 1);
+        // Facet 1 turns about the crease (the y axis) by rho, valley positive.
+        let state = |rho: f64| -> Vec<[f64; 3]> {
+            layout
+                .iter()
+                .enumerate()
+                .map(|(v, p)| {
+                    if [4, 5, 6].contains(&v) {
+                        [p[0] * rho.cos(), p[1], -p[0] * rho.sin()]
+                    } else {
+                        [p[0], p[1], 0.0]
+                    }
+                })
+                .collect()
+        };
+        for rho in [0.0, 0.4, -0.4, 2.0, -2.0] {
+            let got = c.fold_angles(&state(rho))[0];
+            assert!((got - rho).abs() < 1e-12, "{rho} vs {got}");
+        }
+        for sign in [1.0, -1.0] {
+            let mut tr = StateTracker::new(&c);
+            for k in 0..=10 {
+                let rho = sign * 0.1 * f64::from(k);
+                let flips: Vec<_> = tr
+                    .step(&state(rho), rho, false)
+                    .into_iter()
+                    .filter(|i| i.kind == IntersectionKind::Flip)
+                    .collect();
+                assert!(flips.is_empty(), "flip reported at rho = {rho}");
+            }
+        }
     }
 
     #[test]

@@ -30,6 +30,9 @@ pub enum BenchCommand {
     /// One design model: objective and constraints with gradients by JIT, interpreter and
     /// f64 + central differences, and the compile latency.
     Model(super::bench_model::ModelBenchArgs),
+    /// One folding motion of one design: the compiled PTU model against the bar-and-hinge
+    /// simulation (thesis Sec. 3), same states.
+    Numeric(super::bench_numeric::NumericBenchArgs),
 }
 
 /// Run `foldsynth bench`.
@@ -37,6 +40,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     match args.what {
         BenchCommand::Vertex(a) => run_vertex(a),
         BenchCommand::Model(a) => super::bench_model::run(a),
+        BenchCommand::Numeric(a) => super::bench_numeric::run(a),
     }
 }
 

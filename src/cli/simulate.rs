@@ -76,7 +76,11 @@ enum Kind {
 }
 
 fn kind_of(path: &Path) -> Kind {
-    match path.extension().and_then(|e| e.to_str()).map(str::to_lowercase) {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_lowercase)
+    {
         Some(e) if e == "fold" => Kind::Fold,
         Some(e) if e == "json" => Kind::Design,
         _ => Kind::Toml,
@@ -105,8 +109,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         Kind::Fold => {
             let fold = FoldFile::read(&path)?;
             let mut pattern = fold.to_pattern()?;
-            let note = if fold.frames.len() > 1 && fold.frames[1..].iter().any(|f| f.t.is_none())
-            {
+            let note = if fold.frames.len() > 1 && fold.frames[1..].iter().any(|f| f.t.is_none()) {
                 // Without foldsynth:t the frames' t is unknown: they cannot be compared or
                 // give the angle, so the drive comes from the flags alone.
                 pattern.frames.clear();
@@ -187,8 +190,8 @@ fn legend(names: &[String]) -> String {
 /// A design JSON: `{"pattern": <Pattern>, …}` (any other keys are ignored), or a bare
 /// Pattern. Returns a display name (`id`, else the file name) and the pattern.
 pub fn read_design(path: &Path) -> anyhow::Result<(String, Pattern)> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("{}: not valid JSON", path.display()))?;
     let body = match v.get("pattern") {
@@ -335,9 +338,10 @@ fn run_pattern(
     if r.compared_states > 0 {
         let _ = writeln!(
             o,
-            "vs the frames       max |x - X| {:.3e} over {} states; final {}; prescribed vertices {:.3e}",
+            "vs the frames       max |x - X| {:.3e} over {} states ({} ill-conditioned, within their error bound); final {}; prescribed vertices {:.3e}",
             r.max_position_error,
             r.compared_states,
+            r.widened_states,
             r.final_position_error
                 .map_or("not compared".into(), |e| format!("{e:.3e}")),
             r.drive_error
@@ -449,6 +453,7 @@ fn run_crossval(dir: &Path, args: &SimulateArgs) -> anyhow::Result<()> {
                     "max_position_error": r.max_position_error,
                     "final_position_error": r.final_position_error,
                     "drive_error": r.drive_error,
+                    "widened_states": r.widened_states,
                     "start_gap": r.start_gap,
                     "agrees": pass(r),
                 }),
@@ -514,7 +519,10 @@ fn run_crossval(dir: &Path, args: &SimulateArgs) -> anyhow::Result<()> {
         emit(&o)?;
     }
     if failed > 0 {
-        bail!("{failed} of {} designs do not agree with the PTU", rows.len());
+        bail!(
+            "{failed} of {} designs do not agree with the PTU",
+            rows.len()
+        );
     }
     Ok(())
 }

@@ -2,7 +2,7 @@
 //! respect to the free variables in one call, with the modes and the times as parameters
 //! (one compiled function serves all 2^N mode assignments).
 
-use super::Model;
+use super::{Model, geometry};
 use crate::compile::{self, Compiled, Options};
 use crate::expr::{Ctx, Sym};
 use crate::optimize::{Evaluation, Problem};
@@ -96,6 +96,74 @@ impl CompiledModel {
                 e.dg[k * n..(k + 1) * n].copy_from_slice(&buf[l.gradient(k + 1)]);
             }
         }
+    }
+}
+
+/// A design's motion compiled to native code: the position of every vertex at `t`. `t` is
+/// the one variable; the free variables, then the modes, are parameters, so one compiled
+/// function serves every design of the graph. No gradients: this is the PTU's forward
+/// kinematics, the counterpart of one bar-and-hinge simulation step
+/// (`foldsynth bench numeric`).
+#[derive(Debug)]
+pub struct CompiledMotion {
+    /// The compiled function (outputs: x, y, z of vertex 0, then vertex 1, …).
+    pub compiled: Compiled,
+    /// Number of vertices.
+    pub n_vertices: usize,
+    /// Milliseconds from the start of the build to native code.
+    pub total_ms: f64,
+}
+
+impl CompiledMotion {
+    /// Build, simplify and compile the motion of `model`'s graph.
+    pub fn new(model: &Model, opts: &Options) -> Result<CompiledMotion, compile::CompileError> {
+        let start = Instant::now();
+        let ctx = Ctx::new();
+        let t = ctx.var(0);
+        let nf = model.free.len();
+        let free: Vec<Sym> = (0..nf).map(|k| ctx.param(k)).collect();
+        let vars = model.full_vars(&free);
+        let modes: Vec<Sym> = (0..model.plan.internal.len())
+            .map(|i| ctx.param(nf + i))
+            .collect();
+        let flat = geometry::flat(&model.plan, &vars);
+        let folded = geometry::fold(&model.plan, &flat, &modes, &t);
+        let n_vertices = model.plan.vertices.len();
+        let ids: Vec<_> = (0..n_vertices)
+            .flat_map(|v| geometry::position(&model.plan, &flat, &folded, v))
+            .map(|c| ctx.node_id(&c))
+            .collect();
+        let graph = ctx.to_graph();
+        let n_params = nf + model.plan.internal.len();
+        let opts = Options {
+            gradients: false,
+            ..opts.clone()
+        };
+        let compiled = compile::compile(&graph, &ids, 1, n_params, &opts)?;
+        Ok(CompiledMotion {
+            compiled,
+            n_vertices,
+            total_ms: start.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+
+    /// The parameter vector of a design: its free variables, then its modes (±1).
+    pub fn params(free: &[f64], modes: &[f64]) -> Vec<f64> {
+        free.iter().chain(modes).copied().collect()
+    }
+
+    /// Every vertex's position at `t` into `out` (3 per vertex, sized
+    /// [`CompiledMotion::buffer_len`]).
+    pub fn positions(&self, t: f64, params: &[f64], out: &mut [f64]) {
+        self.compiled
+            .function
+            .call(&[t], params, out)
+            .expect("buffer sizes match the compiled layout");
+    }
+
+    /// Length of the output buffer.
+    pub fn buffer_len(&self) -> usize {
+        self.compiled.layout.len()
     }
 }
 

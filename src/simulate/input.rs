@@ -136,6 +136,11 @@ pub struct SolverSettings {
     /// the step squared) while branches stay apart. `f64::INFINITY` (the default) turns
     /// it off; the cross-validation uses 0.02 (see [`super::crossval`]).
     pub max_correction: f64,
+    /// Most halvings of one step (default 6: up to 2^6 = 64 substeps). Near a vertex's
+    /// rigid limit its creases turn like √(t_lim − t), arbitrarily fast, and a design that
+    /// ends just short of its limit (Eq. 33 keeps only 1e-8) needs many more to follow
+    /// its branch; the cross-validation allows 18.
+    pub max_refine: usize,
 }
 
 impl Default for SolverSettings {
@@ -146,6 +151,7 @@ impl Default for SolverSettings {
             step_tolerance: 1e-15,
             residual_tolerance: 1e-15,
             max_correction: f64::INFINITY,
+            max_refine: 6,
         }
     }
 }

@@ -86,9 +86,6 @@ impl SimReport {
 /// step and in two half steps before the step is refined.
 pub const BRANCH_TOLERANCE: f64 = 1e-4;
 
-/// Most halvings of one step (up to 2^6 = 64 substeps).
-const MAX_REFINE: usize = 6;
-
 /// Takes one reported step by continuation.
 ///
 /// Each step starts from the previous solution (Eq. 3), moved along the motion's tangent
@@ -210,7 +207,7 @@ impl Stepper<'_> {
             self.substeps += 1;
             return Ok(full);
         }
-        if depth >= MAX_REFINE {
+        if depth >= self.input.solver.max_refine {
             self.substeps += 1;
             return Ok(full);
         }
@@ -222,7 +219,7 @@ impl Stepper<'_> {
             .zip(&two)
             .flat_map(|(a, b)| (0..3).map(move |u| (a[u] - b[u]).abs()))
             .fold(0.0, f64::max);
-        let kappa: f64 = std::env::var("FS_KAPPA").ok().and_then(|v| v.parse().ok()).unwrap_or(self.input.solver.max_correction);
+        let kappa = self.input.solver.max_correction;
         if gap <= self.branch_tol && corrected <= kappa * moved {
             self.substeps += 1;
             return Ok(two);

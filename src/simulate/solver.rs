@@ -301,3 +301,27 @@ pub fn solve(
         cost,
     }
 }
+
+/// The Jacobian of the bar residuals with respect to the free coordinates (`slot[v] =
+/// Some(k)`: columns `3k..3k+3`), one row per bar. Its smallest singular value bounds how
+/// far a residual r can leave the vertices from an exact solution: ‖Δx‖ ≲ ‖r‖/σ_min.
+pub fn jacobian(
+    bars: &Bars,
+    slot: &[Option<usize>],
+    n_free: usize,
+    x: &[[f64; 3]],
+) -> DMatrix<f64> {
+    let mut jac = DMatrix::<f64>::zeros(bars.pairs.len(), 3 * n_free);
+    for (b, &[i, j]) in bars.pairs.iter().enumerate() {
+        for u in 0..3 {
+            let d = 2.0 * (x[i][u] - x[j][u]);
+            if let Some(k) = slot[i] {
+                jac[(b, 3 * k + u)] += d;
+            }
+            if let Some(k) = slot[j] {
+                jac[(b, 3 * k + u)] -= d;
+            }
+        }
+    }
+    jac
+}
