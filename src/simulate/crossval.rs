@@ -30,7 +30,7 @@
 //! use foldsynth::model::Model;
 //! use foldsynth::simulate::crossval::{CrossvalOptions, crossval_design};
 //! use foldsynth::task::Task;
-//! let task = Task::load("grammar/gripper.toml".as_ref()).unwrap();
+//! let task = Task::load(std::path::Path::new("grammar/gripper.toml")).unwrap();
 //! let graph = CreaseGraph::from_sequence(&task, "2").unwrap();
 //! let model = Model::new(&graph, &task, 0).unwrap();
 //! let mid: Vec<f64> = model.free.iter().map(|&i| {
