@@ -5,8 +5,9 @@
 //! The PTU side evaluates every vertex's position at t₀ … t_J with the JIT-compiled
 //! forward kinematics ([`CompiledMotion`]); the plain f64 path (the same generic code,
 //! not compiled) is a second row. The simulation side runs the G0 drive of
-//! [`crate::simulate::crossval`] over the same J steps, once with Eq. 2's bars as in the
-//! thesis and once with the rigid panels the cross-validation uses; no intersection
+//! [`crate::simulate::crossval`] over the same J steps, once with Eq. 2's bars and the
+//! simulator's default settings, as in the thesis, and once with the rigid panels and
+//! settings the cross-validation uses; no intersection
 //! check on either side, so both compute kinematics only. Both motions are compared at
 //! the end, so the times are of the same motion.
 
@@ -214,7 +215,12 @@ fn sim_input(
         Vec::new()
     };
     input.first_step_offsets = branch_offsets(&pattern, &input, &apexes);
-    input.solver = CrossvalOptions::default().solver;
+    // Rigid panels: the cross-validation's settings. Eq. 2's bars: the simulator's own
+    // defaults, as `foldsynth simulate` runs the thesis's model (its flexible quadrilaterals
+    // would send the cross-validation's deep step refinement down to 2^18 substeps).
+    if panels {
+        input.solver = CrossvalOptions::default().solver;
+    }
     Ok(input)
 }
 

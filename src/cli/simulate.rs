@@ -19,6 +19,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::Args;
+use rayon::prelude::*;
 use serde_json::json;
 
 use crate::export::fold::FoldFile;
@@ -401,8 +402,9 @@ fn run_crossval(dir: &Path, args: &SimulateArgs) -> anyhow::Result<()> {
         rigid_panels: !args.eq2_bars,
         ..Default::default()
     };
+    // One design per task on the rayon pool (`collect` keeps the files' order).
     let rows: Vec<Row> = files
-        .iter()
+        .par_iter()
         .map(|path| match read_design(path) {
             Err(e) => Row {
                 name: path.display().to_string(),
