@@ -5,6 +5,8 @@
 //! (≤ 1e-12 relative). Gradients agree with central differences; a point that breaks
 //! Eq. 25 at t_max is reported as not rigid, with finite coordinates.
 
+mod common;
+use common::Feasibility;
 use foldsynth::check::verify::{Tolerances, verify};
 use foldsynth::compile::Options;
 use foldsynth::grammar::{CreaseGraph, Enumeration, Filters};
@@ -16,26 +18,6 @@ use foldsynth::task::Task;
 
 fn task() -> Task {
     Task::load(concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper.toml")).unwrap()
-}
-
-/// The model's constraints alone (objective 0): minimizing it finds points satisfying ψ.
-struct Feasibility<'a>(ModelProblem<'a>);
-
-impl Problem for Feasibility<'_> {
-    fn n_vars(&self) -> usize {
-        self.0.n_vars()
-    }
-    fn n_constraints(&self) -> usize {
-        self.0.n_constraints()
-    }
-    fn bounds(&self, i: usize) -> (f64, f64) {
-        self.0.bounds(i)
-    }
-    fn eval(&self, x: &[f64], out: &mut Evaluation) {
-        self.0.eval(x, out);
-        out.f = 0.0;
-        out.df.iter_mut().for_each(|d| *d = 0.0);
-    }
 }
 
 fn close(a: f64, b: f64) -> bool {

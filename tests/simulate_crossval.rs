@@ -5,13 +5,15 @@
 //! every state equals the PTU's X(t) (≤ 1e-7). Perturbed off its rigid range, the same
 //! design distorts: Γ > 1e-4 (the thesis's bound).
 
+mod common;
+use common::Feasibility;
 use foldsynth::check::verify::{Tolerances, verify};
 use foldsynth::compile::Options;
 use foldsynth::grammar::CreaseGraph;
 use foldsynth::model::Model;
 use foldsynth::model::compiled::{CompiledModel, CompiledMotion, ModelProblem};
 use foldsynth::model::numeric::{Evaluated, sample_times};
-use foldsynth::optimize::{self, Evaluation, Problem};
+use foldsynth::optimize;
 use foldsynth::simulate::crossval::{
     CrossvalOptions, GAMMA_TOL, POSITION_TOL, crossval, crossval_design, design_drive,
 };
@@ -19,26 +21,6 @@ use foldsynth::task::Task;
 
 fn task() -> Task {
     Task::load(concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper.toml")).unwrap()
-}
-
-/// The model's constraints alone (objective 0): minimizing it finds points satisfying ψ.
-struct Feasibility<'a>(ModelProblem<'a>);
-
-impl Problem for Feasibility<'_> {
-    fn n_vars(&self) -> usize {
-        self.0.n_vars()
-    }
-    fn n_constraints(&self) -> usize {
-        self.0.n_constraints()
-    }
-    fn bounds(&self, i: usize) -> (f64, f64) {
-        self.0.bounds(i)
-    }
-    fn eval(&self, x: &[f64], out: &mut Evaluation) {
-        self.0.eval(x, out);
-        out.f = 0.0;
-        out.df.iter_mut().for_each(|d| *d = 0.0);
-    }
 }
 
 /// Up to `want` points of `sequence` with `modes` that satisfy ψ and whose PTU motion is

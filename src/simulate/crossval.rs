@@ -52,6 +52,7 @@ use super::input::{AngleFn, Drive, SimInput, SolverSettings};
 use super::run::{RIGID_DELTA, SimError, SimReport, simulate_with_checker};
 use super::solver::{Bars, jacobian};
 use crate::check::{CheckError, Checker};
+use crate::geom;
 use crate::model::Model;
 use crate::model::numeric::{Evaluated, sample_times};
 use crate::pattern::{EdgeKind, Pattern};
@@ -372,22 +373,13 @@ pub struct PanelApex {
 /// of facet `face` at `coords`: where a rigid panel's apex is when the facet is where
 /// `coords` puts it.
 fn apex_at(coords: &[[f64; 3]], face: &[usize], height: f64) -> [f64; 3] {
-    let k = face.len() as f64;
-    let mut c = [0.0; 3];
-    let mut n = Vector3::zeros();
-    for (i, &v) in face.iter().enumerate() {
-        let (a, b) = (coords[v], coords[face[(i + 1) % face.len()]]);
-        for u in 0..3 {
-            c[u] += a[u] / k;
-        }
-        n += Vector3::new(
-            (a[1] - b[1]) * (a[2] + b[2]),
-            (a[2] - b[2]) * (a[0] + b[0]),
-            (a[0] - b[0]) * (a[1] + b[1]),
-        );
-    }
-    let n = n / n.norm();
-    [0, 1, 2].map(|u| c[u] + height * n[u])
+    let pts: Vec<[f64; 3]> = face.iter().map(|&v| coords[v]).collect();
+    let k = pts.len() as f64;
+    let c = pts
+        .iter()
+        .fold([0.0; 3], |c, &p| geom::add(c, geom::scale(p, 1.0 / k)));
+    let n = geom::normalize(geom::newell_normal(&pts)).unwrap_or([0.0, 0.0, 1.0]);
+    geom::add(c, geom::scale(n, height))
 }
 
 /// Make every facet with more than three vertices a rigid panel: one apex vertex above
@@ -413,7 +405,7 @@ pub fn add_panel_apexes(input: &mut SimInput) -> Vec<PanelApex> {
             [0, 1, 2].map(|u| face.iter().map(|&v| input.initial[v][u]).sum::<f64>() / k);
         let r2 = face
             .iter()
-            .map(|&v| dist(&input.initial[v], &c).powi(2))
+            .map(|&v| geom::dist(input.initial[v], c).powi(2))
             .sum::<f64>()
             / k;
         let height = r2.sqrt();
@@ -475,10 +467,6 @@ pub fn branch_offsets(
 
 fn same_t(a: f64, b: f64) -> bool {
     (a - b).abs() <= SAME_T * a.abs().max(b.abs()).max(1.0)
-}
-
-fn dist(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
 /// Settings of [`crossval`].
@@ -683,13 +671,13 @@ fn compare(
         let err = frame.map(|f| {
             x.iter()
                 .zip(&f.coords)
-                .map(|(a, b)| dist(a, b))
+                .map(|(a, b)| geom::dist(*a, *b))
                 .fold(0.0, f64::max)
         });
         if let Some(f) = frame {
             let d = prescribed
                 .iter()
-                .map(|&v| dist(&x[v], &f.coords[v]))
+                .map(|&v| geom::dist(x[v], f.coords[v]))
                 .fold(0.0, f64::max);
             if j == 0 {
                 start_gap = err;
