@@ -521,10 +521,11 @@ fn run_crossval(dir: &Path, args: &SimulateArgs) -> anyhow::Result<()> {
         emit(&o)?;
     }
     if failed > 0 {
-        bail!(
+        return Err(super::CheckFailed(format!(
             "{failed} of {} designs do not agree with the PTU",
             rows.len()
-        );
+        ))
+        .into());
     }
     Ok(())
 }

@@ -395,6 +395,46 @@ pub fn picked_frames(n: usize, count: usize) -> Vec<usize> {
     out
 }
 
+impl Files {
+    /// Every path, in writing order.
+    pub fn all(&self) -> Vec<PathBuf> {
+        let mut v = vec![
+            self.fold.clone(),
+            self.svg.clone(),
+            self.obj.clone(),
+            self.stl.clone(),
+        ];
+        for (png, svg) in self.pngs.iter().zip(&self.folded_svgs) {
+            v.push(png.clone());
+            v.push(svg.clone());
+        }
+        v.extend(self.gif.clone());
+        v
+    }
+}
+
+/// The files [`write_all`] writes for `pattern` with `opts` into `out_dir` (so a caller can
+/// list them before they exist).
+pub fn planned_files(out_dir: &Path, pattern: &Pattern, opts: &ExportOptions) -> Files {
+    let path = |ext: &str| out_dir.join(format!("{}.{ext}", opts.name));
+    let picked = picked_frames(pattern.frames.len(), opts.picture_states);
+    Files {
+        fold: path("fold"),
+        svg: path("svg"),
+        obj: path("obj"),
+        stl: path("stl"),
+        pngs: picked
+            .iter()
+            .map(|k| out_dir.join(format!("{}_state{k}.png", opts.name)))
+            .collect(),
+        folded_svgs: picked
+            .iter()
+            .map(|k| out_dir.join(format!("{}_state{k}.svg", opts.name)))
+            .collect(),
+        gif: (opts.gif && !pattern.frames.is_empty()).then(|| path("gif")),
+    }
+}
+
 /// Write every file for one design into `out_dir` (created if missing): FOLD, crease
 /// pattern SVG, OBJ and STL of the final state, PNG and SVG pictures of a few states,
 /// and the GIF animation. With `meta.second_arm`, pictures and meshes show both arms.
@@ -416,14 +456,7 @@ pub fn write_all(
         path: out_dir.to_path_buf(),
         source,
     })?;
-    let path = |ext: &str| out_dir.join(format!("{}.{ext}", opts.name));
-    let mut files = Files {
-        fold: path("fold"),
-        svg: path("svg"),
-        obj: path("obj"),
-        stl: path("stl"),
-        ..Files::default()
-    };
+    let files = planned_files(out_dir, pattern, opts);
     write_file(
         &files.fold,
         fold::to_fold_string(pattern, meta, opts.fold_spec)?,
@@ -450,21 +483,16 @@ pub fn write_all(
     write_file(&files.stl, stl)?;
 
     let scene = render::Scene::new(pattern, meta, opts.camera)?;
-    for k in picked_frames(pattern.frames.len(), opts.picture_states) {
-        let png = out_dir.join(format!("{}_state{k}.png", opts.name));
-        write_file(&png, scene.png(Some(k), opts.image_size)?)?;
-        files.pngs.push(png);
-        let fsvg = out_dir.join(format!("{}_state{k}.svg", opts.name));
-        write_file(&fsvg, scene.svg(Some(k), opts.image_size))?;
-        files.folded_svgs.push(fsvg);
+    let picked = picked_frames(pattern.frames.len(), opts.picture_states);
+    for ((k, png), fsvg) in picked.iter().zip(&files.pngs).zip(&files.folded_svgs) {
+        write_file(png, scene.png(Some(*k), opts.image_size)?)?;
+        write_file(fsvg, scene.svg(Some(*k), opts.image_size))?;
     }
-    if opts.gif && !pattern.frames.is_empty() {
-        let gif = path("gif");
+    if let Some(gif) = &files.gif {
         write_file(
-            &gif,
+            gif,
             scene.gif(opts.image_size, opts.gif_delay_cs, opts.gif_max_frames)?,
         )?;
-        files.gif = Some(gif);
     }
     Ok(files)
 }

@@ -127,9 +127,7 @@ pub struct Enumeration {
 
 /// The search tree grew past the graph budget given to [`Enumeration::run_limited`].
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "the search tree exceeded {limit} graphs at level {level} (N_max = {n_max}); switch the isomorphism filter on or lower N_max"
-)]
+#[error("the search tree exceeded {limit} graphs at level {level} (N_max = {n_max})")]
 pub struct TooLarge {
     /// The budget.
     pub limit: usize,
@@ -137,6 +135,61 @@ pub struct TooLarge {
     pub level: usize,
     /// The N_max requested.
     pub n_max: usize,
+}
+
+/// How many graphs an enumeration would generate: counted at smaller N_max as far as
+/// they fit the budget, then extrapolated by the last growth ratio per internal vertex.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GraphEstimate {
+    /// (N_max, graphs generated) for every smaller N_max that fits the budget.
+    pub measured: Vec<(usize, usize)>,
+    /// Growth per internal vertex used to extrapolate.
+    pub ratio: f64,
+    /// The estimate at the requested N_max.
+    pub graphs: f64,
+}
+
+impl GraphEstimate {
+    /// Why an enumeration at `n_max` with `filters` is refused, for the user: the
+    /// estimate, what it would take, what fits, and which switch would help.
+    pub fn refusal(&self, task: &str, n_max: usize, filters: Filters) -> String {
+        use crate::limits::{GRAPH_BYTES, GRAPHS_MAX};
+        let gb = |graphs: f64| graphs * GRAPH_BYTES as f64 / 1e9;
+        let measured: Vec<String> = self
+            .measured
+            .iter()
+            .rev()
+            .take(2)
+            .rev()
+            .map(|(k, g)| format!("{g} at N_max = {k}"))
+            .collect();
+        let mut s = format!(
+            "N_max = {n_max} is too large for task '{task}': about {:.0} graphs, about {:.0} GB in memory (counted: {}; ×{:.1} per internal vertex). One enumeration keeps at most {GRAPHS_MAX} graphs ({:.1} GB).",
+            self.graphs,
+            gb(self.graphs),
+            if measured.is_empty() {
+                "none fits".to_string()
+            } else {
+                measured.join(", ")
+            },
+            self.ratio,
+            gb(GRAPHS_MAX as f64),
+        );
+        let mut helps = Vec::new();
+        if let Some((k, _)) = self.measured.last() {
+            helps.push(format!("lower N_max to {k}"));
+        }
+        if !filters.isomorphism {
+            helps.push("switch the isomorphism filter on (drop --no-iso)".to_string());
+        }
+        if !filters.mirror {
+            helps.push("switch the mirror filter on (drop --no-mirror)".to_string());
+        }
+        if !helps.is_empty() {
+            s.push_str(&format!(" To run: {}.", helps.join(", or ")));
+        }
+        s
+    }
 }
 
 impl Enumeration {
@@ -226,6 +279,34 @@ impl Enumeration {
             filters,
             mirror_applied,
         })
+    }
+
+    /// Estimate the graphs of an enumeration at `n_max` without generating more than
+    /// `max_graphs` at once (see [`GraphEstimate`]).
+    pub fn estimate(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        max_graphs: usize,
+    ) -> GraphEstimate {
+        let mut measured = Vec::new();
+        for k in 1..=n_max {
+            match Self::run_limited(task, k, filters, max_graphs) {
+                Ok(e) => measured.push((k, e.nodes.len())),
+                Err(_) => break,
+            }
+        }
+        let ratio = match measured.as_slice() {
+            [.., (_, a), (_, b)] if *a > 0 && *b > *a => *b as f64 / *a as f64,
+            // Too little to measure: the growth seen on the bundled tasks.
+            _ => 20.0,
+        };
+        let (k, g) = measured.last().copied().unwrap_or((0, 1));
+        GraphEstimate {
+            graphs: g as f64 * ratio.powi((n_max - k) as i32),
+            measured,
+            ratio,
+        }
     }
 
     /// The generated graph with this rule sequence, if it was generated.

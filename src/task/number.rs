@@ -32,8 +32,8 @@ impl Number {
 impl fmt::Display for Number {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Number::Literal(v) => write!(f, "{v}"),
-            Number::Expr(s) => write!(f, "\"{s}\""),
+            Number::Literal(v) => f.write_str(&crate::text::num(*v)),
+            Number::Expr(s) => write!(f, "\"{}\"", crate::text::excerpt(s, 60)),
         }
     }
 }
