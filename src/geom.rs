@@ -63,6 +63,18 @@ pub fn dist(a: V3, b: V3) -> f64 {
     norm(sub(a, b))
 }
 
+/// The largest of `xs` (0 for none), NaN if any is NaN: `f64::max` would drop a NaN and
+/// let a failed comparison pass.
+pub fn max_or_nan(xs: impl IntoIterator<Item = f64>) -> f64 {
+    xs.into_iter().fold(0.0, |m: f64, x| {
+        if x.is_nan() || m.is_nan() {
+            f64::NAN
+        } else {
+            m.max(x)
+        }
+    })
+}
+
 /// a / |a|, or `None` for a zero vector.
 pub fn normalize(a: V3) -> Option<V3> {
     let n = norm(a);
@@ -317,4 +329,32 @@ mod tests {
         faces.sort();
         assert_eq!(faces, vec![vec![0, 1, 3], vec![1, 2, 3]]);
     }
+}
+
+/// The least-squares plane of a point set: through the centroid, normal along the
+/// covariance's eigenvector of the smallest eigenvalue (unit length, sign arbitrary).
+/// `None` for fewer than three points or points on one line or point.
+pub fn fit_plane(points: &[V3]) -> Option<(V3, V3)> {
+    if points.len() < 3 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let c = scale(points.iter().fold([0.0; 3], |a, &p| add(a, p)), 1.0 / n);
+    let mut m = nalgebra::Matrix3::<f64>::zeros();
+    for p in points {
+        let d = nalgebra::Vector3::from(sub(*p, c));
+        m += d * d.transpose();
+    }
+    if !m.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let eig = nalgebra::SymmetricEigen::new(m);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
+    // Points on a line (two vanishing eigenvalues) span no plane.
+    if eig.eigenvalues[order[1]] <= f64::EPSILON * eig.eigenvalues[order[2]].abs() {
+        return None;
+    }
+    let v = eig.eigenvectors.column(order[0]);
+    normalize([v[0], v[1], v[2]]).map(|nrm| (c, nrm))
 }

@@ -157,11 +157,22 @@ pub(crate) fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
     })
 }
 
+/// Every number finite and within ±[`crate::limits::COORD_MAX`]: larger ones overflow
+/// squared distances (1e308 gives an infinite error that compares as "within bounds").
 fn check_finite(what: impl FnOnce() -> String, xs: &[f64]) -> Result<()> {
-    if xs.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(ExportError::invalid(what(), "non-finite number"))
+    match xs
+        .iter()
+        .find(|x| !(x.is_finite() && x.abs() <= crate::limits::COORD_MAX))
+    {
+        None => Ok(()),
+        Some(x) => Err(ExportError::invalid(
+            what(),
+            format!(
+                "{} is not allowed: numbers must be finite and within ±{}",
+                crate::text::num(*x),
+                crate::text::num(crate::limits::COORD_MAX)
+            ),
+        )),
     }
 }
 
@@ -212,12 +223,7 @@ pub fn validate_pattern(p: &Pattern) -> Result<()> {
         }
     }
     for (j, fr) in p.frames.iter().enumerate() {
-        if !fr.t.is_finite() {
-            return Err(ExportError::invalid(
-                format!("pattern.frames[{j}].t"),
-                "non-finite number",
-            ));
-        }
+        check_finite(|| format!("pattern.frames[{j}].t"), &[fr.t])?;
         if fr.coords.len() != n {
             return Err(ExportError::invalid(
                 format!("pattern.frames[{j}].coords"),
@@ -517,7 +523,7 @@ pub struct DesignFile {
 impl DesignFile {
     /// Read and validate a design JSON file.
     pub fn read(path: &Path) -> Result<DesignFile> {
-        let text = std::fs::read_to_string(path).map_err(|source| ExportError::Io {
+        let text = crate::limits::read_text(path).map_err(|source| ExportError::Io {
             path: path.to_path_buf(),
             source,
         })?;

@@ -173,7 +173,7 @@ impl PatternFile {
     /// Read and parse a pattern file.
     pub fn load(path: &Path) -> Result<PatternFile, PatternFileError> {
         let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| PatternFileError {
+        let text = crate::limits::read_text(path).map_err(|e| PatternFileError {
             origin: origin.clone(),
             field: "file".into(),
             message: format!("cannot read: {e}"),
@@ -352,8 +352,15 @@ impl PatternFile {
         };
         let t_start = constant("motion.t_start", &spec.motion.t_start)?;
         let t_end = constant("motion.t_end", &spec.motion.t_end)?;
-        if spec.motion.steps == 0 {
-            return Err(err("motion.steps", "must be at least 1".into()));
+        let max = crate::limits::STEPS_MAX;
+        if spec.motion.steps == 0 || spec.motion.steps as u64 > max {
+            return Err(err(
+                "motion.steps",
+                format!(
+                    "{} is not allowed: must be at least 1 and at most {max}",
+                    spec.motion.steps
+                ),
+            ));
         }
         let formula = |field: &str, n: &Num| -> Result<Formula, PatternFileError> {
             match n {
