@@ -13,6 +13,7 @@ pub mod cli;
 pub mod compile;
 pub mod export;
 pub mod expr;
+pub mod fuzz;
 pub mod geom;
 pub mod grammar;
 pub mod kinematics;

@@ -32,6 +32,31 @@ pub fn cut_lines(message: &str, max: usize) -> String {
         .join("\n")
 }
 
+/// A window of at most `width` characters of `input` around character `pos`, and the
+/// column of `pos` in it: to point at an error in a long input without echoing it whole.
+pub fn window(input: &str, pos: usize, width: usize) -> (String, usize) {
+    let chars: Vec<char> = input.chars().collect();
+    let pos = pos.min(chars.len());
+    if chars.len() <= width {
+        return (input.to_string(), pos);
+    }
+    let start = pos
+        .saturating_sub(width / 2)
+        .min(chars.len().saturating_sub(width));
+    let end = (start + width).min(chars.len());
+    let mut s = String::new();
+    let mut col = pos - start;
+    if start > 0 {
+        s.push('…');
+        col += 1;
+    }
+    s.extend(&chars[start..end]);
+    if end < chars.len() {
+        s.push('…');
+    }
+    (s, col)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -46,5 +71,9 @@ mod tests {
         assert_eq!(num(0.25), "0.25");
         assert_eq!(num(-3e-9), "-3e-9");
         assert_eq!(num(f64::INFINITY), "inf");
+        let (w, col) = window(&long, 50_000, 20);
+        assert_eq!(w.chars().count(), 22);
+        assert_eq!(col, 11);
+        assert_eq!(window("abc", 1, 20), ("abc".to_string(), 1));
     }
 }

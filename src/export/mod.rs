@@ -281,10 +281,14 @@ pub fn validate_meta(meta: &DesignMeta, p: &Pattern) -> Result<()> {
     if let Some(c) = &meta.obstacle {
         check_finite(|| "meta.obstacle.a".into(), &c.a)?;
         check_finite(|| "meta.obstacle.b".into(), &c.b)?;
-        if !(c.radius.is_finite() && c.radius > 0.0) {
+        if !(c.radius.is_finite() && c.radius > 0.0 && c.radius <= crate::limits::COORD_MAX) {
             return Err(ExportError::invalid(
                 "meta.obstacle.radius",
-                format!("{} is not allowed; the radius must be > 0", c.radius),
+                format!(
+                    "{} is not allowed; the radius must be > 0 and at most {}",
+                    crate::text::num(c.radius),
+                    crate::text::num(crate::limits::COORD_MAX)
+                ),
             ));
         }
         if crate::geom::norm(crate::geom::sub(c.b, c.a)) == 0.0 {
@@ -527,17 +531,23 @@ impl DesignFile {
             path: path.to_path_buf(),
             source,
         })?;
-        let d: DesignFile = serde_json::from_str(&text).map_err(|e| {
+        DesignFile::parse(&text, &path.display().to_string())
+    }
+
+    /// Parse and validate design JSON text; `source` names it in messages.
+    pub fn parse(text: &str, source: &str) -> Result<DesignFile> {
+        let d: DesignFile = serde_json::from_str(text).map_err(|e| {
             ExportError::invalid(
-                path.display().to_string(),
+                source,
                 format!(
-                    "not a design file ({e}); expected {{\"pattern\": {{vertices, edges, faces, frames}}, \"meta\": {{task, …}}}}"
+                    "not a design file ({}); expected {{\"pattern\": {{vertices, edges, faces, frames}}, \"meta\": {{task, …}}}}",
+                    crate::text::excerpt(&e.to_string(), 200)
                 ),
             )
         })?;
         validate_pattern(&d.pattern)
             .and_then(|()| validate_meta(&d.meta, &d.pattern))
-            .map_err(|e| ExportError::invalid(path.display().to_string(), e.to_string()))?;
+            .map_err(|e| ExportError::invalid(source, e.to_string()))?;
         Ok(d)
     }
 }

@@ -554,19 +554,28 @@ pub fn read_records(
     path: &Path,
     wanted: &dyn Fn(&str) -> bool,
 ) -> Result<(Vec<AlternativeRecord>, ResumeReport), OutputError> {
+    match File::open(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            Ok((Vec::new(), ResumeReport::default()))
+        }
+        Err(e) => Err(io_err(path)(e)),
+        Ok(file) => parse_records(BufReader::new(file), wanted).map_err(io_err(path)),
+    }
+}
+
+/// [`read_records`] on any reader.
+pub fn parse_records(
+    mut reader: impl BufRead,
+    wanted: &dyn Fn(&str) -> bool,
+) -> std::io::Result<(Vec<AlternativeRecord>, ResumeReport)> {
     let mut report = ResumeReport::default();
-    let file = match File::open(path) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok((Vec::new(), report)),
-        r => r.map_err(io_err(path))?,
-    };
-    let mut reader = BufReader::new(file);
     let mut buf = Vec::new();
     let mut seen: HashSet<String> = HashSet::new();
     let mut out = Vec::new();
     let mut line = 0;
     loop {
         buf.clear();
-        if reader.read_until(b'\n', &mut buf).map_err(io_err(path))? == 0 {
+        if reader.read_until(b'\n', &mut buf)? == 0 {
             break;
         }
         line += 1;

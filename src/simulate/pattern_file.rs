@@ -220,7 +220,7 @@ impl PatternFile {
                     &format!("{field}.name"),
                     format!(
                         "'{}' is not allowed: names are non-empty, without '@' or spaces",
-                        v.name
+                        crate::text::excerpt(&v.name, 40)
                     ),
                 ));
             }
@@ -240,10 +240,15 @@ impl PatternFile {
                     ));
                 }
             };
-            if p.iter().any(|x| !x.is_finite()) {
+            if p.iter()
+                .any(|x| !(x.is_finite() && x.abs() <= crate::limits::COORD_MAX))
+            {
                 return Err(err(
                     &format!("{field}.at"),
-                    "coordinates must be finite".into(),
+                    format!(
+                        "coordinates must be finite and within ±{}",
+                        crate::text::num(crate::limits::COORD_MAX)
+                    ),
                 ));
             }
             let on_axis = rot > 1 && p[0].abs() <= 1e-12 && p[1].abs() <= 1e-12;

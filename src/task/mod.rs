@@ -514,7 +514,7 @@ impl Task {
                     return Err(cx.err(
                         "check.states",
                         format!(
-                            "{} is not allowed: 2 (0 and t_max) to {max} states",
+                            "{} is not allowed: at least 2 states (0 and t_max), at most {max}",
                             c.states
                         ),
                     ));
