@@ -22,12 +22,22 @@ pub fn num(x: f64) -> String {
     }
 }
 
-/// Every line of `message` cut to `max` characters: the last guard against echoing a
-/// huge input back whole.
+/// Every line of `message` cut to about `max` characters, keeping its start and its end
+/// (where a usage error names the option): the last guard against echoing a huge input
+/// back whole.
 pub fn cut_lines(message: &str, max: usize) -> String {
     message
         .lines()
-        .map(|l| excerpt(l, max))
+        .map(|l| {
+            let n = l.chars().count();
+            if n <= max {
+                return l.to_string();
+            }
+            let (head, tail) = (max * 2 / 3, max / 3);
+            let start: String = l.chars().take(head).collect();
+            let end: String = l.chars().skip(n - tail).collect();
+            format!("{start}… ({} characters cut) …{end}", n - head - tail)
+        })
         .collect::<Vec<_>>()
         .join("\n")
 }
@@ -55,6 +65,31 @@ pub fn window(input: &str, pos: usize, width: usize) -> (String, usize) {
         s.push('…');
     }
     (s, col)
+}
+
+/// When `text` is clearly another kind of foldsynth file than `expected` ("task" or
+/// "pattern"), say which and which command takes it: a task file given to `simulate`
+/// should not read as "unknown field `bounds`".
+pub fn other_kind(text: &str, expected: &str) -> Option<String> {
+    let start = text.trim_start();
+    if start.starts_with('{') || start.starts_with('[') && start[1..].trim_start().starts_with('{')
+    {
+        return Some(format!(
+            "this is JSON (a FOLD or design file?), not a {expected} file: `foldsynth verify` and `foldsynth simulate` take FOLD files, `foldsynth export` and `foldsynth simulate` design files"
+        ));
+    }
+    let table: toml::Table = text.parse().ok()?;
+    let task = table.contains_key("initial_graph") || table.contains_key("grammar");
+    let pattern = table.contains_key("vertices") && table.contains_key("faces");
+    match expected {
+        "pattern" if task && !pattern => Some(
+            "this is a task file (it has [grammar] and [initial_graph]): `foldsynth simulate` takes a pattern file (such as grammar/flasher_adapted.toml), a FOLD file (.fold) or a design JSON (.json). A task's designs come from `foldsynth synthesize TASK`; `foldsynth simulate --crossval OUT` simulates them all".into(),
+        ),
+        "task" if pattern && !task => Some(
+            "this is a pattern file of the bar-and-hinge simulator (it has vertices and faces): `foldsynth simulate FILE` runs it; this command takes a task file (such as grammar/gripper.toml)".into(),
+        ),
+        _ => None,
+    }
 }
 
 #[cfg(test)]

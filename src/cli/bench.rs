@@ -338,7 +338,7 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     // A NaN or a deviation where the vertex is rigid is a failed check (exit 1).
     let verdict = || -> Result<()> {
         match peer_dev {
-            Some(d) if rigid_here && !(d <= 1e-6) => Err(super::CheckFailed(format!(
+            Some(d) if rigid_here && (d.is_nan() || d > 1e-6) => Err(super::CheckFailed(format!(
                 "CasADi and foldsynth disagree at t = {t}, where the vertex is rigid: relative deviation {}",
                 if d.is_nan() {
                     "NaN".to_string()

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use serde::Serialize;
 
 use crate::grammar::{Enumeration, Filters, Status};
@@ -82,13 +82,8 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
     };
     // Every generated graph is kept (about 15 kB each): what does not fit the budget is
     // refused with its estimated size, before memory runs out.
-    let Ok(e) = Enumeration::run_limited(&task, n_max, filters, GRAPHS_MAX) else {
-        bail!(
-            "{}",
-            Enumeration::estimate(&task, n_max, filters, GRAPHS_MAX)
-                .refusal(&task.name, n_max, filters)
-        );
-    };
+    let e = Enumeration::run_within(&task, n_max, filters, GRAPHS_MAX)
+        .map_err(|est| anyhow::anyhow!("{}", est.refusal(&task.name, n_max, filters)))?;
     if let Some(path) = &args.tree {
         std::fs::write(path, e.to_dot())
             .with_context(|| format!("cannot write the search tree to {}", path.display()))?;

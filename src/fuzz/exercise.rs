@@ -144,7 +144,7 @@ pub fn fold(text: &str) -> bool {
         // The simulator on one small pattern in sixteen: a motion it cannot follow costs
         // up to its refinement budget (seconds), which would dominate the run.
         if p.vertices.len() <= 16
-            && text.len() % 16 == 0
+            && text.len().is_multiple_of(16)
             && let Ok(edge) = G0Drive::marked_edge(&p)
         {
             let drive = if p.frames.is_empty() {

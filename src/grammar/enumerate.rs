@@ -150,6 +150,21 @@ pub struct GraphEstimate {
 }
 
 impl GraphEstimate {
+    /// Extrapolate `measured` (N_max, graphs) to `n_max` by the last growth ratio.
+    pub fn extrapolate(measured: Vec<(usize, usize)>, n_max: usize) -> GraphEstimate {
+        let ratio = match measured.as_slice() {
+            [.., (_, a), (_, b)] if *a > 0 && *b > *a => *b as f64 / *a as f64,
+            // Too little to measure: the growth seen on the bundled tasks.
+            _ => 20.0,
+        };
+        let (k, g) = measured.last().copied().unwrap_or((0, 1));
+        GraphEstimate {
+            graphs: g as f64 * ratio.powi(n_max.saturating_sub(k) as i32),
+            measured,
+            ratio,
+        }
+    }
+
     /// Why an enumeration at `n_max` with `filters` is refused, for the user: the
     /// estimate, what it would take, what fits, and which switch would help.
     pub fn refusal(&self, task: &str, n_max: usize, filters: Filters) -> String {
@@ -281,32 +296,28 @@ impl Enumeration {
         })
     }
 
-    /// Estimate the graphs of an enumeration at `n_max` without generating more than
-    /// `max_graphs` at once (see [`GraphEstimate`]).
-    pub fn estimate(
+    /// Enumerate up to `n_max` keeping at most `max_graphs` graphs, or say why not with an
+    /// estimate. The smaller N_max are counted first (together about a twentieth of the
+    /// last): an N_max whose extrapolated size is far beyond the budget is refused without
+    /// being tried, so the refusal costs no more memory than the largest N_max that fits.
+    pub fn run_within(
         task: &Task,
         n_max: usize,
         filters: Filters,
         max_graphs: usize,
-    ) -> GraphEstimate {
+    ) -> Result<Enumeration, GraphEstimate> {
         let mut measured = Vec::new();
-        for k in 1..=n_max {
+        for k in 1..n_max {
             match Self::run_limited(task, k, filters, max_graphs) {
                 Ok(e) => measured.push((k, e.nodes.len())),
-                Err(_) => break,
+                Err(_) => return Err(GraphEstimate::extrapolate(measured, n_max)),
             }
         }
-        let ratio = match measured.as_slice() {
-            [.., (_, a), (_, b)] if *a > 0 && *b > *a => *b as f64 / *a as f64,
-            // Too little to measure: the growth seen on the bundled tasks.
-            _ => 20.0,
-        };
-        let (k, g) = measured.last().copied().unwrap_or((0, 1));
-        GraphEstimate {
-            graphs: g as f64 * ratio.powi((n_max - k) as i32),
-            measured,
-            ratio,
+        let estimate = GraphEstimate::extrapolate(measured, n_max);
+        if estimate.graphs > 2.0 * max_graphs as f64 {
+            return Err(estimate);
         }
+        Self::run_limited(task, n_max, filters, max_graphs).map_err(|_| estimate)
     }
 
     /// The generated graph with this rule sequence, if it was generated.

@@ -484,7 +484,13 @@ impl<'a> Parser<'a> {
             let at = self.pos;
             let a = self.number()?;
             if !(a > 0.0 && a < 180.0) {
-                return Err(self.error_at(at, format!("sector angle {a}° is outside (0°, 180°)")));
+                return Err(self.error_at(
+                    at,
+                    format!(
+                        "sector angle {}° is outside (0°, 180°)",
+                        crate::text::num(a)
+                    ),
+                ));
             }
             out.push(a);
             if !self.eat(',') {

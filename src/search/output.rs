@@ -353,14 +353,13 @@ impl OutputDir {
 
     /// Keep the entries of an earlier manifest that stay (`keep`) in this run's manifest.
     fn adopt(&self, old: &Manifest, keep: &[&str]) -> Result<(), OutputError> {
-        if let Ok(mut m) = self.manifest.lock() {
-            for f in keep {
-                if old.files.contains(*f) {
-                    m.files.insert((*f).to_string());
-                }
+        let mut m = self.manifest.lock().unwrap_or_else(|e| e.into_inner());
+        for f in keep {
+            if old.files.contains(*f) {
+                m.files.insert((*f).to_string());
             }
         }
-        self.save()
+        Self::write_manifest(&self.root, &m)
     }
 
     /// Delete the files an earlier manifest lists (except `keep`), then its directories
@@ -409,20 +408,18 @@ impl OutputDir {
         notes
     }
 
-    /// Write the manifest (atomically: a temporary file renamed over it).
+    /// Write the manifest (atomically: a temporary file renamed over it). The lock is held
+    /// throughout, so workers listing files at once do not race on the temporary file.
     fn save(&self) -> Result<(), OutputError> {
-        let m = self
-            .manifest
-            .lock()
-            .map_err(|_| OutputError::Refused {
-                path: self.root.display().to_string(),
-                message: "the manifest lock is poisoned (a worker panicked)".into(),
-            })?
-            .clone();
-        let tmp = self.root.join(format!("{MANIFEST}.tmp"));
-        let text = serde_json::to_string_pretty(&m).unwrap_or_default();
+        let m = self.manifest.lock().unwrap_or_else(|e| e.into_inner());
+        Self::write_manifest(&self.root, &m)
+    }
+
+    fn write_manifest(root: &Path, m: &Manifest) -> Result<(), OutputError> {
+        let tmp = root.join(format!("{MANIFEST}.tmp"));
+        let text = serde_json::to_string_pretty(m).unwrap_or_default();
         fs::write(&tmp, text + "\n").map_err(io_err(&tmp))?;
-        let path = self.root.join(MANIFEST);
+        let path = root.join(MANIFEST);
         fs::rename(&tmp, &path).map_err(io_err(&path))
     }
 
@@ -442,19 +439,18 @@ impl OutputDir {
         &self,
         paths: impl IntoIterator<Item = P>,
     ) -> Result<(), OutputError> {
-        if let Ok(mut m) = self.manifest.lock() {
-            for p in paths {
-                let p = p.as_ref();
-                let rel = p.strip_prefix(&self.root).unwrap_or(p);
-                let rel = rel
-                    .components()
-                    .map(|c| c.as_os_str().to_string_lossy())
-                    .collect::<Vec<_>>()
-                    .join("/");
-                m.files.insert(rel);
-            }
+        let mut m = self.manifest.lock().unwrap_or_else(|e| e.into_inner());
+        for p in paths {
+            let p = p.as_ref();
+            let rel = p.strip_prefix(&self.root).unwrap_or(p);
+            let rel = rel
+                .components()
+                .map(|c| c.as_os_str().to_string_lossy())
+                .collect::<Vec<_>>()
+                .join("/");
+            m.files.insert(rel);
         }
-        self.save()
+        Self::write_manifest(&self.root, &m)
     }
 
     /// Create the directory `rel` (listed in the manifest when this run creates it).
@@ -471,10 +467,11 @@ impl OutputDir {
             }
             Err(_) => {}
         }
-        if let Ok(mut m) = self.manifest.lock() {
+        {
+            let mut m = self.manifest.lock().unwrap_or_else(|e| e.into_inner());
             m.dirs.insert(rel.to_string());
+            Self::write_manifest(&self.root, &m)?;
         }
-        self.save()?;
         fs::create_dir_all(&path).map_err(io_err(&path))?;
         Ok(path)
     }
@@ -622,13 +619,4 @@ pub fn write_records(
     }
     f.flush().map_err(io_err(&path))?;
     Ok((path, f))
-}
-
-/// FNV-1a (64 bits) of `bytes`, as 16 hex digits: a digest to notice an edited task file.
-pub fn digest(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in bytes {
-        h = (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
-    }
-    format!("{h:016x}")
 }

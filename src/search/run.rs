@@ -357,11 +357,8 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     }
 
     let t0 = Instant::now();
-    let Ok(enumeration) = Enumeration::run_limited(task, n_max, Filters::all(), limits::GRAPHS_MAX)
-    else {
-        let estimate = Enumeration::estimate(task, n_max, Filters::all(), limits::GRAPHS_MAX);
-        return Err(terr(&estimate.refusal(&task.name, n_max, Filters::all())));
-    };
+    let enumeration = Enumeration::run_within(task, n_max, Filters::all(), limits::GRAPHS_MAX)
+        .map_err(|est| terr(&est.refusal(&task.name, n_max, Filters::all())))?;
     let graphs: Vec<&CreaseGraph> = enumeration.meaningful().map(|n| &n.graph).collect();
     let enumerate_s = t0.elapsed().as_secs_f64();
     if graphs.is_empty() {

@@ -188,8 +188,17 @@ impl PatternFile {
             field: field.to_string(),
             message,
         };
-        let spec: Spec = toml::from_str(text)
-            .map_err(|e| err("toml", e.to_string().trim_end().replace('\n', "\n    ")))?;
+        if let Some(kind) = crate::text::other_kind(text, "pattern") {
+            return Err(err("(file)", kind));
+        }
+        let spec: Spec = toml::from_str(text).map_err(|e| {
+            err(
+                "toml",
+                crate::text::excerpt(&e.to_string(), 600)
+                    .trim_end()
+                    .replace('\n', "\n    "),
+            )
+        })?;
         let rot = match &spec.symmetry {
             None => 1,
             Some(s) if (1..=360).contains(&s.rotations) => s.rotations,

@@ -364,6 +364,9 @@ impl Task {
     /// Parse and validate task text; `file` labels the messages.
     pub fn from_toml_str(text: &str, file: &str) -> Result<Task, TaskError> {
         let cx = Ctx { file };
+        if let Some(kind) = crate::text::other_kind(text, "task") {
+            return Err(cx.err("(file)", kind));
+        }
         let raw: RawTask = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
         let name = raw.name.clone().unwrap_or_default();
         check_name(&name).map_err(|m| cx.err("name", m))?;
@@ -619,6 +622,6 @@ fn syntax_error(file: &str, text: &str, e: &toml::de::Error) -> TaskError {
     TaskError {
         file: file.to_owned(),
         field,
-        message: format!("{loc}{}", e.message().trim()),
+        message: format!("{loc}{}", crate::text::excerpt(e.message().trim(), 300)),
     }
 }
