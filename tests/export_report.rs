@@ -28,7 +28,6 @@ use foldsynth::export::report::{
 };
 use foldsynth::export::verify::{VerifyOptions, verify_file};
 use foldsynth::export::{DesignMeta, ExportOptions, samples, write_all};
-use foldsynth::pattern::Pattern;
 use serde_json::{Value, json};
 
 fn margin(value: f64, setting: f64, t: f64, at: &str) -> Value {
@@ -37,14 +36,7 @@ fn margin(value: f64, setting: f64, t: f64, at: &str) -> Value {
 
 /// Three sample designs with different levels, objectives and robustness records. The
 /// scores follow the contract: min over the present margins of value / setting.
-fn sample_designs() -> Vec<(
-    String,
-    usize,
-    Option<usize>,
-    Pattern,
-    DesignMeta,
-    Option<Value>,
-)> {
+fn sample_designs() -> Vec<ReportDesign> {
     let (pg, mut mg) = samples::demo_gripper();
     mg.objective = Some(3e-7);
     mg.extra.insert("key".into(), json!("2|2|down"));
@@ -72,41 +64,40 @@ fn sample_designs() -> Vec<(
         objective: Some(5e-9),
         ..DesignMeta::default()
     };
+    let design = |id: &str, level, candidate, pattern, meta, robustness| ReportDesign {
+        id: id.into(),
+        level,
+        candidate,
+        pattern,
+        meta,
+        robustness,
+        facts: vec![Fact::new("note", "a \"quoted\" <value>")],
+        design_file: None,
+        files: None,
+        verify: None,
+    };
     vec![
-        ("d-arm".into(), 2, None, pa, ma, Some(rob_a)),
-        ("d-grip".into(), 1, Some(2), pg, mg, Some(rob_g)),
-        ("d-deg4".into(), 1, Some(1), p4, m4, None),
+        design("d-arm", 2, None, pa, ma, Some(rob_a)),
+        design("d-grip", 1, Some(2), pg, mg, Some(rob_g)),
+        design("d-deg4", 1, Some(1), p4, m4, None),
     ]
 }
 
 fn build_report(out: &Path, export: bool) -> (PathBuf, ReportInput) {
-    let mut designs = Vec::new();
-    for (id, level, candidate, p, m, rob) in sample_designs() {
-        let (files, verify) = if export {
+    let mut designs = sample_designs();
+    if export {
+        for d in &mut designs {
             let opts = ExportOptions {
-                name: id.clone(),
+                name: d.id.clone(),
                 image_size: (120, 90),
                 gif_max_frames: 4,
                 ..ExportOptions::default()
             };
-            let files = write_all(&out.join("designs").join(&id), &p, &m, &opts).unwrap();
-            let v = verify_file(&files.fold, &VerifyOptions::default()).unwrap();
-            (Some(files), Some(v))
-        } else {
-            (None, None)
-        };
-        designs.push(ReportDesign {
-            id,
-            level,
-            candidate,
-            pattern: p,
-            meta: m,
-            robustness: rob,
-            facts: vec![Fact::new("note", "a \"quoted\" <value>")],
-            design_file: None,
-            files,
-            verify,
-        });
+            let files =
+                write_all(&out.join("designs").join(&d.id), &d.pattern, &d.meta, &opts).unwrap();
+            d.verify = Some(verify_file(&files.fold, &VerifyOptions::default()).unwrap());
+            d.files = Some(files);
+        }
     }
     let tree = vec![
         TreeNode {

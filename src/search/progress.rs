@@ -152,14 +152,17 @@ impl Progress {
         }
         match &self.shared.out {
             Output::Bar(b) => {
-                b.reset();
-                b.set_message(format!("{name} ({unit})"));
+                b.set_message(if unit.is_empty() {
+                    name.to_string()
+                } else {
+                    format!("{name} ({unit})")
+                });
                 match total {
                     Some(n) => {
                         b.disable_steady_tick();
                         b.set_style(
                             ProgressStyle::with_template(
-                                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}, {per_sec}, ETA {eta}",
+                                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} {msg}, ETA {eta}",
                             )
                             .expect("valid template"),
                         );
@@ -173,6 +176,8 @@ impl Progress {
                         b.enable_steady_tick(Duration::from_millis(120));
                     }
                 }
+                // Position, elapsed time and ETA start afresh with the phase.
+                b.reset();
             }
             Output::Lines(_) => self.shared.line(&match total {
                 Some(n) => format!("{name}: {n} {unit} to do"),
