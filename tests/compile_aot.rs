@@ -336,6 +336,10 @@ fn check_task(task_file: &str, modes: &str, name: &str) {
     assert_eq!(manifest["constants"]["n_vars"], n);
     assert_eq!(manifest["constants"]["n_out"], jit.buffer_len());
     assert_eq!(manifest["constants"]["jacobian_offset"], 1 + m + n);
+    assert_eq!(manifest["layout"]["jacobian"]["offset"], 1 + m + n);
+    assert_eq!(manifest["layout"]["jacobian"]["rows"], m);
+    assert_eq!(manifest["layout"]["constraints"]["len"], m);
+    assert_eq!(manifest["layout"]["len"], (1 + m) * (1 + n));
     assert_eq!(manifest["variables"][0]["lower"], lo[0]);
     assert_eq!(manifest["model"]["graph"], GRAPH);
     assert_eq!(

@@ -140,6 +140,12 @@ pub fn manifest(
     iface: &Interface,
 ) -> Json {
     let mut out = aot::manifest(iface, &compiled.compiled.layout);
+    let (n, m) = (compiled.n_vars, compiled.n_constraints);
+    let layout = &mut out["layout"];
+    layout["objective"] = json!({"offset": 0});
+    layout["constraints"] = json!({"offset": 1, "len": m});
+    layout["gradient"] = json!({"offset": 1 + m, "len": n});
+    layout["jacobian"] = json!({"offset": 1 + m + n, "rows": m, "cols": n, "order": "row-major"});
     let rep = &compiled.compiled.report;
     let dropped: Vec<Json> = model
         .plan
