@@ -47,8 +47,8 @@ pub struct ModelArgs {
     /// Seed for --optimize.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Number of states of the verification sweep over [0, t_max], 2 to 10000.
-    #[arg(long, default_value_t = 97, value_parser = crate::limits::count::<2, { crate::limits::SWEEP_MAX as u64 }>)]
+    /// Number of states of the verification sweep over [0, t_max] (as `synthesize --sweep`), 2 to 10000.
+    #[arg(long, default_value_t = crate::search::SearchOptions::default().sweep, value_parser = crate::limits::count::<2, { crate::limits::SWEEP_MAX as u64 }>)]
     pub sweep: usize,
     /// Print JSON.
     #[arg(long)]

@@ -363,7 +363,7 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             .into_iter()
             .find(|&(k, _)| nrm[k].abs() >= 1.0 - 1e-9);
         match axis {
-            Some((k, name)) => format!("the plane {name} = {:.6}", c[k] + 0.0),
+            Some((k, name)) => format!("the plane {name} = {:.4}", tidy(c[k])),
             None => format!(
                 "the plane through ({:.4}, {:.4}, {:.4}) with normal ({:.4}, {:.4}, {:.4})",
                 tidy(c[0]),

@@ -16,7 +16,8 @@ use crate::model::Model;
 use crate::model::numeric::{Evaluated, sample_times};
 use crate::pattern::Pattern;
 use crate::simulate::crossval::{CrossvalOptions, G0Drive, crossval};
-use crate::simulate::{Formula, PatternFile, simulate};
+use crate::simulate::run::REFINE_ITERATION_BUDGET;
+use crate::simulate::{Formula, PatternFile, SolverSettings, simulate};
 use crate::task::Task;
 
 /// Values of t every expression and vertex is evaluated at (inside and outside [0, π]).
@@ -141,8 +142,9 @@ pub fn fold(text: &str) -> bool {
         && validate_pattern(&p).is_ok()
     {
         write_pattern(&p, &DesignMeta::default());
-        // The simulator on one small pattern in sixteen: a motion it cannot follow costs
-        // up to its refinement budget (seconds), which would dominate the run.
+        // The simulator on one small pattern in sixteen, with a tenth of the default
+        // refinement budget: a motion it cannot follow costs up to that budget (seconds),
+        // which would dominate the run.
         if p.vertices.len() <= 16
             && text.len().is_multiple_of(16)
             && let Ok(edge) = G0Drive::marked_edge(&p)
@@ -158,6 +160,10 @@ pub fn fold(text: &str) -> bool {
                     &drive,
                     &CrossvalOptions {
                         steps: Some(1),
+                        solver: SolverSettings {
+                            refine_budget: REFINE_ITERATION_BUDGET / 10,
+                            ..CrossvalOptions::default().solver
+                        },
                         ..CrossvalOptions::default()
                     },
                 );

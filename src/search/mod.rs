@@ -12,8 +12,11 @@
 //! its records may be reused.
 
 pub mod output;
+mod progress;
 mod record;
+mod report;
 mod run;
 
+pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
 pub use record::{AlternativeRecord, Summary, Timings, level_distribution};
 pub use run::{Alternative, SearchError, SearchOptions, prepare, run};

@@ -45,7 +45,7 @@ pub struct StepReport {
     pub iterations: usize,
     /// Substeps the step was finally taken in (1 unless a branch jump forced refinement).
     pub substeps: usize,
-    /// Whether refinement stopped at [`REFINE_ITERATION_BUDGET`] before the half steps
+    /// Whether refinement stopped at its budget ([`REFINE_ITERATION_BUDGET`] by default) before the half steps
     /// agreed: a motion no small step can follow (e.g. a prescribed vertex that jumps).
     #[serde(default)]
     pub refinement_capped: bool,
@@ -90,11 +90,14 @@ impl SimReport {
 /// step and in two half steps before the step is refined.
 pub const BRANCH_TOLERANCE: f64 = 1e-4;
 
-/// Most solver iterations one reported step may spend on refinement. A step that follows
-/// a branch refines along one path (a few hundred iterations even at 18 halvings); a
-/// motion that no step size can follow would otherwise refine every half down to
-/// `max_refine`, 2^18 substeps: hours, found by fuzzing.
-pub const REFINE_ITERATION_BUDGET: usize = 200_000;
+/// Most solver iterations one reported step may spend on refinement, by default
+/// ([`super::SolverSettings::refine_budget`]). A step that follows
+/// a branch refines along one path; near a flat or singular state that can take a few
+/// hundred thousand (352,111 for the last step of the gripper's g06-c2-uu at N_max = 2,
+/// seed 1), so the budget is several times that. A motion that no step size can follow
+/// would otherwise refine every half down to `max_refine`, 2^18 substeps: hours, found
+/// by fuzzing.
+pub const REFINE_ITERATION_BUDGET: usize = 2_000_000;
 
 /// Takes one reported step by continuation.
 ///
@@ -223,7 +226,7 @@ impl Stepper<'_> {
             self.substeps += 1;
             return Ok(full);
         }
-        if self.iterations >= REFINE_ITERATION_BUDGET {
+        if self.iterations >= self.input.solver.refine_budget {
             self.capped = true;
             self.substeps += 1;
             return Ok(full);
