@@ -1,8 +1,10 @@
 //! Text shown to the user: echoes of their input cut to a readable length, numbers in a
 //! form that reads (a 309-digit number is `1e308`).
 
-/// `s` cut to at most `max` characters, saying how many were left out.
+/// `s` cut to at most `max` characters, saying how many were left out (long digit runs
+/// cut first, see [`cut_digit_runs`]).
 pub fn excerpt(s: &str, max: usize) -> String {
+    let s = &cut_digit_runs(s);
     let n = s.chars().count();
     if n <= max {
         return s.to_string();
@@ -29,6 +31,7 @@ pub fn cut_lines(message: &str, max: usize) -> String {
     message
         .lines()
         .map(|l| {
+            let l = &cut_digit_runs(l);
             let n = l.chars().count();
             if n <= max {
                 return l.to_string();
@@ -40,6 +43,34 @@ pub fn cut_lines(message: &str, max: usize) -> String {
         })
         .collect::<Vec<_>>()
         .join("\n")
+}
+
+/// Runs of more than 24 digits (a parser echoing `1e308` in full) cut to their first six
+/// and their length: `100000… (309 digits)`.
+pub fn cut_digit_runs(s: &str) -> String {
+    const KEEP: usize = 6;
+    const LONG: usize = 24;
+    let mut out = String::with_capacity(s.len().min(4096));
+    let mut run = String::new();
+    let flush = |run: &mut String, out: &mut String| {
+        if run.len() > LONG {
+            out.push_str(&run[..KEEP]);
+            out.push_str(&format!("… ({} digits)", run.len()));
+        } else {
+            out.push_str(run);
+        }
+        run.clear();
+    };
+    for c in s.chars() {
+        if c.is_ascii_digit() {
+            run.push(c);
+        } else {
+            flush(&mut run, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut run, &mut out);
+    out
 }
 
 /// A window of at most `width` characters of `input` around character `pos`, and the
@@ -110,5 +141,14 @@ mod tests {
         assert_eq!(w.chars().count(), 22);
         assert_eq!(col, 11);
         assert_eq!(window("abc", 1, 20), ("abc".to_string(), 1));
+        let huge = format!(
+            "invalid type: floating point `1{}`, expected",
+            "0".repeat(308)
+        );
+        assert_eq!(
+            cut_lines(&huge, 1000),
+            "invalid type: floating point `100000… (309 digits)`, expected"
+        );
+        assert_eq!(cut_digit_runs("12345 and 1.5"), "12345 and 1.5");
     }
 }
