@@ -6,7 +6,9 @@
 use crate::compile::vertex::{self, VertexModel};
 use crate::compile::{Dual, Options, compile};
 use crate::expr::Tape;
+use crate::geom::max_or_nan;
 use crate::kinematics::VertexSpec;
+use crate::kinematics::foldability::{self, RIGID_TOL};
 use anyhow::{Context, Result, bail};
 use serde_json::json;
 use std::hint::black_box;
@@ -73,7 +75,7 @@ pub struct VertexBenchArgs {
     pub t: Option<f64>,
     /// Milliseconds of measurement per row (split into rounds of batches; the fastest
     /// round's median batch is reported).
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u64).range(1..=crate::limits::BENCH_MILLIS_MAX))]
     pub millis: u64,
     /// The peer script (default: the crate's benches/peers/casadi_vertex.py).
     #[arg(long)]
@@ -133,8 +135,8 @@ fn rel(a: f64, b: f64) -> f64 {
 pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     let spec = VertexSpec::parse(&args.spec).context("invalid vertex")?;
     let t = args.t.unwrap_or_else(|| vertex::most_rigid_t(&spec));
-    if !t.is_finite() {
-        bail!("--t must be a finite number");
+    if !(t.is_finite() && t.abs() <= crate::limits::COORD_MAX) {
+        bail!("--t must be a finite number within ±1e6");
     }
     let sym = args.symbolic_sectors;
     let (vars, params) = vertex::point(&spec, sym, t);
@@ -193,10 +195,9 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     let fd = central(&vars);
     let grad: Vec<f64> = buf[compiled.layout.gradient(0)].to_vec();
     let value = buf[0];
-    let max_dev_dual = (0..n)
-        .map(|i| rel(grad[i], dual.g.get(i).copied().unwrap_or(0.0)))
-        .fold(0.0, f64::max);
-    let max_dev_fd = (0..n).map(|i| rel(grad[i], fd[i])).fold(0.0, f64::max);
+    let max_dev_dual =
+        max_or_nan((0..n).map(|i| rel(grad[i], dual.g.get(i).copied().unwrap_or(0.0))));
+    let max_dev_fd = max_or_nan((0..n).map(|i| rel(grad[i], fd[i])));
     let max_dev_value = rel(buf[0], f64_value).max(rel(buf[0], tbuf[0]));
 
     // Timings. Every row is measured in each of several rounds (the peer's harness too)
@@ -307,16 +308,48 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     };
 
     // The peer's own numbers against ours (the same function at the same point).
-    let peer_dev = peer.as_ref().and_then(|p| {
-        let v = p.get("value")?.as_f64()?;
-        let g = p.get("grad")?.as_array()?;
-        let mut d = rel(v, value);
-        for (i, gi) in g.iter().enumerate() {
-            // CasADi's gradient may be NaN where ours is guarded (sqrt at 0).
-            d = d.max(rel(gi.as_f64().unwrap_or(f64::NAN), grad[i]));
+    // `null` is the harness's NaN (JSON has none): CasADi's gradient is NaN outside the
+    // rigid interval, where ours is guarded (sqrt at 0). NaN stays NaN in the maximum.
+    let peer_nan = |p: &serde_json::Value| -> Vec<String> {
+        let mut out = Vec::new();
+        if p.get("value").is_some_and(|v| v.is_null()) {
+            out.push("value".to_string());
         }
-        Some(d)
+        if let Some(g) = p.get("grad").and_then(|g| g.as_array()) {
+            out.extend(
+                g.iter()
+                    .enumerate()
+                    .filter(|(_, x)| x.is_null())
+                    .map(|(i, _)| format!("grad[{i}]")),
+            );
+        }
+        out
+    };
+    let peer_nans = peer.as_ref().map(peer_nan).unwrap_or_default();
+    let peer_dev = peer.as_ref().and_then(|p| {
+        let v = p.get("value")?;
+        let g = p.get("grad")?.as_array()?;
+        let num = |x: &serde_json::Value| x.as_f64().unwrap_or(f64::NAN);
+        Some(max_or_nan(std::iter::once(rel(num(v), value)).chain(
+            g.iter().enumerate().map(|(i, gi)| rel(num(gi), grad[i])),
+        )))
     });
+    let rigid_here = foldability::min_margin(&spec, t) >= -RIGID_TOL;
+    // A NaN or a deviation where the vertex is rigid is a failed check (exit 1).
+    let verdict = || -> Result<()> {
+        match peer_dev {
+            Some(d) if rigid_here && (d.is_nan() || d > 1e-6) => Err(super::CheckFailed(format!(
+                "CasADi and foldsynth disagree at t = {t}, where the vertex is rigid: relative deviation {}",
+                if d.is_nan() {
+                    "NaN".to_string()
+                } else {
+                    format!("{d:.1e}")
+                }
+            ))
+            .into()),
+            _ => Ok(()),
+        }
+    };
 
     let ops_before = rep.input.ops;
     let ops_after = rep.simplified.ops;
@@ -364,10 +397,12 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
             if let Some(ms) = p.get("total_compile_ms").and_then(|v| v.as_f64()) {
                 o["peer_compile_ratio"] = json!(compile_ms / ms);
             }
-            o["peer_max_rel_dev"] = json!(peer_dev);
+            o["peer_max_rel_dev"] = json!(peer_dev.filter(|d| d.is_finite()));
+            o["peer_nan"] = json!(peer_nans);
+            o["rigid_at_t"] = json!(rigid_here);
         }
         println!("{}", serde_json::to_string_pretty(&o)?);
-        return Ok(());
+        return verdict();
     }
 
     println!(
@@ -436,12 +471,20 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     println!(
         "checks: value vs f64/interpreter {max_dev_value:.1e}, gradient vs dual {max_dev_dual:.1e}, vs central differences {max_dev_fd:.1e}"
     );
-    if let Some(d) = peer_dev {
-        println!(
-            "CasADi's value and gradient vs ours: {d:.1e} (NaN: CasADi's gradient is not guarded)"
-        );
+    match peer_dev {
+        Some(d) if d.is_finite() => println!("CasADi's value and gradient vs ours: {d:.1e}"),
+        Some(_) => println!(
+            "CasADi's value and gradient vs ours: not comparable, CasADi gives NaN for {} at t = {t}{}",
+            peer_nans.join(", "),
+            if rigid_here {
+                ""
+            } else {
+                " (outside the vertex's rigid interval: its sqrt of a negative number is NaN; ours is guarded)"
+            }
+        ),
+        None => {}
     }
-    Ok(())
+    verdict()
 }
 
 enum PeerSetup {

@@ -33,7 +33,7 @@ pub struct ModelBenchArgs {
     #[arg(long, default_value_t = 1)]
     pub candidate: usize,
     /// Milliseconds of measurement per row.
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u64).range(1..=crate::limits::BENCH_MILLIS_MAX))]
     pub millis: u64,
     /// Print one JSON object (times in nanoseconds, compile times in milliseconds).
     #[arg(long)]

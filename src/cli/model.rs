@@ -41,14 +41,14 @@ pub struct ModelArgs {
     /// and verify at the optimum.
     #[arg(long)]
     pub optimize: bool,
-    /// Starting points for --optimize.
-    #[arg(long, default_value_t = 32)]
+    /// Starting points for --optimize, 1 to 1000.
+    #[arg(long, default_value_t = 32, value_parser = crate::limits::count::<1, { crate::limits::STARTS_MAX as u64 }>)]
     pub starts: usize,
     /// Seed for --optimize.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Number of states of the verification sweep over [0, t_max] (as `synthesize --sweep`).
-    #[arg(long, default_value_t = crate::search::SearchOptions::default().sweep)]
+    /// Number of states of the verification sweep over [0, t_max] (as `synthesize --sweep`), 2 to 10000.
+    #[arg(long, default_value_t = crate::search::SearchOptions::default().sweep, value_parser = crate::limits::count::<2, { crate::limits::SWEEP_MAX as u64 }>)]
     pub sweep: usize,
     /// Print JSON.
     #[arg(long)]
@@ -78,8 +78,8 @@ pub fn parse_modes(text: Option<&str>, n: usize) -> Result<Vec<f64>> {
 
 /// Read variable values for the model's free variables from a JSON file.
 pub fn read_vars(model: &Model, path: &Path) -> Result<Vec<f64>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::limits::read_text(path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("{}: not valid JSON", path.display()))?;
     let obj = v.get("variables").unwrap_or(&v);
