@@ -25,11 +25,15 @@
 //! Stages: [`simplify`] (egg), [`diff`] (reverse mode), [`jit`] (Cranelift); [`dual`] is
 //! the forward-mode oracle the tests hold the differentiator to; [`vertex`] builds the
 //! symbolic PTU of one vertex (for `foldsynth formulas` and `foldsynth bench vertex`).
+//! With the cargo feature `symbolica`, `symbolica` is the second pipeline and printer
+//! built on Symbolica (on its own thread).
 
 pub mod diff;
 pub mod dual;
 pub mod jit;
 pub mod simplify;
+#[cfg(feature = "symbolica")]
+pub mod symbolica;
 pub mod vertex;
 
 pub use diff::{gradient, gradients};
