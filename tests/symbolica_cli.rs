@@ -22,8 +22,18 @@ fn foldsynth_in(lock_dir: &std::path::Path, args: &[&str]) -> Output {
         .expect("run foldsynth")
 }
 
+/// A fresh lock directory: Symbolica refuses a `SYMBOLICA_LOCK_DIR` that anyone but its
+/// owner can open, and tempfile's directories follow the umask.
+fn lock_dir() -> tempfile::TempDir {
+    use std::os::unix::fs::PermissionsExt;
+    tempfile::Builder::new()
+        .permissions(std::fs::Permissions::from_mode(0o700))
+        .tempdir()
+        .unwrap()
+}
+
 fn foldsynth(args: &[&str]) -> Output {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = lock_dir();
     foldsynth_in(dir.path(), args)
 }
 
@@ -116,8 +126,7 @@ fn formulas_by_symbolica() {
 
 #[test]
 fn a_second_symbolica_process_is_an_error_not_an_abort() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::create_dir_all(dir.path()).unwrap();
+    let dir = lock_dir();
     let lock =
         std::fs::File::create(dir.path().join("symbolica-restricted-thread-0.lock")).unwrap();
     lock.lock().unwrap();

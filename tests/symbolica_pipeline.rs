@@ -167,8 +167,9 @@ fn bad_input_is_an_error_and_the_thread_lives_on() {
     assert!(max_dev(&ours, &theirs) <= 1e-12);
 }
 
-/// Each of our functions through Symbolica (its own `acos` and two-argument `atan`, our
-/// `sgn`, `clamp`, `select`), by SymJIT and by its evaluator, against our JIT.
+/// Each of our functions through Symbolica (its own `acos`, our `atan2`, `sgn`, `clamp`,
+/// `select`), by both SymJIT evaluators and by its evaluator without JIT, against our
+/// JIT, with `atan2` in all four quadrants.
 #[test]
 fn every_function_agrees_with_ours() {
     let mut g = ExprGraph::new();
@@ -184,7 +185,11 @@ fn every_function_agrees_with_ours() {
         }),
         ("clamp".to_string(), g.add(Node::Clamp(y))),
         ("select".to_string(), g.add(Node::Select(y, x, hx))),
-        ("sqrt".to_string(), g.add(Node::Sqrt(x))),
+        ("sqrt".to_string(), {
+            let xx = g.add(Node::Mul(x, x));
+            let a = g.add(Node::Add(xx, half));
+            g.add(Node::Sqrt(a))
+        }),
         ("sincos".to_string(), {
             let s = g.add(Node::Sin(x));
             let c = g.add(Node::Cos(y));
@@ -201,11 +206,26 @@ fn every_function_agrees_with_ours() {
         n_params: 0,
     })
     .unwrap();
-    for (a, b) in [(0.7, 0.4), (1.3, -0.6), (0.2, 1.7)] {
+    for (a, b) in [
+        (0.7, 0.4),
+        (1.3, -0.6),
+        (-1.2, 0.9),
+        (-0.8, -0.3),
+        (0.2, 1.7),
+    ] {
         let mut buf = vec![0.0; ours.layout.len()];
         ours.function.call(&[a, b], &[], &mut buf).unwrap();
         let jit = peer.eval(&[a, b]).unwrap();
         let ev = peer.eval_interpreted(&[a, b]).unwrap();
+        let values = peer.eval_values(&[a, b]).unwrap();
+        for (k, v) in values.iter().enumerate() {
+            assert!(
+                rel(buf[k], *v) <= 1e-14,
+                "{} at ({a}, {b}): ours {} value-only SymJIT {v}",
+                outs[k].0,
+                buf[k]
+            );
+        }
         for k in 0..buf.len() {
             let what = if k < outs.len() {
                 outs[k].0.clone()

@@ -35,8 +35,8 @@ pub struct SymbolicaPeer {
     inputs: Vec<f64>,
     compile_ms: f64,
     max_rel_dev: f64,
-    /// Deviations from ours: JIT values, JIT gradients, evaluator values, evaluator
-    /// gradients.
+    /// Deviations from ours: JIT values (both JITs), JIT gradients, evaluator values,
+    /// evaluator gradients.
     devs: [f64; 4],
     value_ns: Vec<f64>,
     value_grad_ns: Vec<f64>,
@@ -82,9 +82,11 @@ impl SymbolicaPeer {
         };
         let n_values = peer.n_outputs;
         let jit = peer.eval(&inputs)?;
+        let jit_values = peer.eval_values(&inputs)?;
         let interpreted = peer.eval_interpreted(&inputs)?;
         let devs = [
-            dev(&jit, 0..n_values),
+            // Both JITs' values: value+gradient's and value-only's.
+            dev(&jit, 0..n_values).max(dev(&jit_values, 0..n_values)),
             dev(&jit, n_values..ours.len()),
             dev(&interpreted, 0..n_values),
             dev(&interpreted, n_values..ours.len()),

@@ -10,11 +10,14 @@
 //! the aliases it contains; the chain rule through the aliases is assembled forward
 //! (`dw_k/dx = ∂b_k/∂x + Σ_j ∂b_k/∂w_j · dw_j/dx`), each total derivative again an alias.
 //!
-//! `acos` and `atan2` are Symbolica's own `acos` (of our clamp) and two-argument `atan`.
-//! The functions Symbolica does not have (`sgn`, `clamp`, `select`) are symbols with a
-//! numeric implementation (for its evaluator and JIT), a derivative rule and a
-//! Mathematica/LaTeX spelling. All derivatives are the plain mathematical ones (no
-//! guards): they agree with ours wherever the function is smooth.
+//! Our `acos` is Symbolica's own `acos` of our clamp. The others (`atan2`, `sgn`,
+//! `clamp`, `select`) are symbols with a numeric implementation (for its evaluator and
+//! JIT), a derivative rule and a Mathematica/LaTeX spelling. `atan2` is ours, not
+//! Symbolica's two-argument `atan(x, y)`, because SymJIT 2.28 (under Symbolica 3.0.0)
+//! maps `atan` to its one-argument `arctan` whatever the argument count, so the JIT
+//! computes `atan(x)` where Symbolica's evaluator computes `atan2(y, x)` (symjit's
+//! `Config::symbolica_fun` and `translate_external_fun`). All derivatives are the plain
+//! mathematical ones (no guards): they agree with ours wherever the function is smooth.
 
 use crate::expr::{ExprGraph, Names, Node, NodeId, clamp_unit, select};
 use crate::kinematics::sgn_f64;
@@ -35,8 +38,8 @@ pub(super) struct Funcs {
     /// Symbolica's own `acos` (its derivative, its Mathematica name); ours clamps its
     /// argument, so our `acos(x)` is its `acos(clamp(x))`.
     acos: Symbol,
-    /// Symbolica's own `atan(x, y)`, which is `atan2(y, x)` (Mathematica's `ArcTan`).
-    atan: Symbol,
+    /// `atan2(y, x)`.
+    atan2: Symbol,
     sgn: Symbol,
     clamp: Symbol,
     select: Symbol,
@@ -113,6 +116,24 @@ impl Funcs {
         .build()
         .map_err(err)?;
         let _ = SELECT.set(select);
+        // Not Symbolica's two-argument `atan`: SymJIT (symjit 2.28.3) evaluates `atan(x, y)`
+        // as the one-argument `atan(x)` (Symbolica's evaluator without JIT is right). The
+        // JIT calls this one back through its f64 implementation.
+        let atan2 = spelled(
+            SymbolBuilder::new(wrap_symbol!("atan2")),
+            // Mathematica's ArcTan takes x first.
+            |a| format!("ArcTan[{}, {}]", a[1], a[0]),
+            |a| format!("\\operatorname{{atan2}}\\left({}, {}\\right)", a[0], a[1]),
+        )
+        .with_evaluation_info(EvaluationInfo::new().register(|x: &[f64]| x[0].atan2(x[1])))
+        .with_derivative_function(move |view, arg, out| {
+            let a = args(view);
+            let (y, x) = (&a[0], &a[1]);
+            let r = x * x + y * y;
+            **out = if arg == 0 { x / &r } else { -(y / &r) };
+        })
+        .build()
+        .map_err(err)?;
         let sgn = spelled(
             SymbolBuilder::new(wrap_symbol!("sgn")),
             |a| format!("Sign[{}]", a[0]),
@@ -137,7 +158,7 @@ impl Funcs {
         .map_err(err)?;
         Ok(Funcs {
             acos: ::symbolica::transcendental::acos(),
-            atan: ::symbolica::transcendental::atan(),
+            atan2,
             sgn,
             clamp,
             select,
@@ -320,7 +341,7 @@ pub(super) fn convert(
             Node::Cos(_) => function!(Symbol::COS, &a[0]),
             Node::Sqrt(_) => function!(Symbol::SQRT, &a[0]),
             Node::Acos(_) => function!(funcs.acos, function!(funcs.clamp, &a[0])),
-            Node::Atan2(..) => function!(funcs.atan, &a[1], &a[0]),
+            Node::Atan2(..) => function!(funcs.atan2, &a[0], &a[1]),
             Node::Sgn(_) => function!(funcs.sgn, &a[0]),
             Node::Clamp(_) => function!(funcs.clamp, &a[0]),
             Node::Select(..) => function!(funcs.select, &a[0], &a[1], &a[2]),

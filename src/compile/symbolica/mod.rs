@@ -488,14 +488,7 @@ impl Peer {
             every_alias.extend(aliases.iter().cloned());
             let interpreted = evaluator(&all, &conv.inputs, &every_alias, true)?;
             let t3 = Instant::now();
-            let jit = JITCompilationSettings::default()
-                .direct_translation(std::env::var_os("FS_DIRECT").is_some())
-                .optimization_level(
-                    std::env::var("FS_OPT")
-                        .ok()
-                        .and_then(|v| v.parse().ok())
-                        .unwrap_or(3),
-                );
+            let jit = JITCompilationSettings::default();
             let value_grad = interpreted.jit_compile(jit.clone())?;
             let t4 = Instant::now();
             let value_eval = evaluator(&values, &conv.inputs, &conv.aliases, true)?;
@@ -553,6 +546,17 @@ impl Peer {
         self.with(move |e| {
             let mut out = vec![0.0; len];
             e.value_grad(&inputs, &mut out);
+            out
+        })
+    }
+
+    /// Values only at `inputs`, by the value-only JIT.
+    pub fn eval_values(&self, inputs: &[f64]) -> Result<Vec<f64>, Error> {
+        let len = self.n_outputs;
+        let inputs = inputs.to_vec();
+        self.with(move |e| {
+            let mut out = vec![0.0; len];
+            e.value(&inputs, &mut out);
             out
         })
     }
