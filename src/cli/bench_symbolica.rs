@@ -32,6 +32,7 @@ pub struct SymbolicaPeer {
     peer: Peer,
     #[cfg(feature = "symbolica")]
     report: BuildReport,
+    #[cfg(feature = "symbolica")]
     inputs: Vec<f64>,
     compile_ms: f64,
     max_rel_dev: f64,
@@ -43,6 +44,7 @@ pub struct SymbolicaPeer {
     interpreted_ns: Vec<f64>,
 }
 
+#[cfg(feature = "symbolica")]
 fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / a.abs().max(b.abs()).max(1.0)
 }

@@ -22,12 +22,15 @@
 //! assert!((buf[c.layout.gradient(0).start] - d).abs() < 1e-15);
 //! ```
 //!
-//! Stages: [`simplify`] (egg), [`diff`] (reverse mode), [`jit`] (Cranelift); [`dual`] is
+//! Stages: [`simplify`] (egg), [`diff`] (reverse mode), [`codegen`] (the Cranelift function
+//! builder) behind [`jit`] (in process) and [`aot`] (object, shared library, C header); [`dual`] is
 //! the forward-mode oracle the tests hold the differentiator to; [`vertex`] builds the
 //! symbolic PTU of one vertex (for `foldsynth formulas` and `foldsynth bench vertex`).
 //! With the cargo feature `symbolica`, `symbolica` is the second pipeline and printer
 //! built on Symbolica (on its own thread).
 
+pub mod aot;
+pub mod codegen;
 pub mod diff;
 pub mod dual;
 pub mod jit;
@@ -36,9 +39,10 @@ pub mod simplify;
 pub mod symbolica;
 pub mod vertex;
 
+pub use codegen::{CompileError, OptLevel};
 pub use diff::{gradient, gradients};
 pub use dual::Dual;
-pub use jit::{CompileError, CompiledFn, OptLevel};
+pub use jit::CompiledFn;
 
 use crate::expr::{Counts, ExprGraph, NodeId, check_indices};
 use std::time::Instant;

@@ -418,7 +418,7 @@ pub(super) fn gradients(c: &Converted) -> Result<Gradients, String> {
                 let mut d = body.derivative(c.vars[i]);
                 for (j, p) in &partials {
                     if let Some(dw) = &total[*j][i] {
-                        d = d + p * dw;
+                        d += p * dw;
                     }
                 }
                 d
