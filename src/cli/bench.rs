@@ -51,6 +51,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
 pub enum Peer {
     /// CasADi SX, reverse-mode gradient, generated C compiled with `gcc -O3`.
     Casadi,
+    /// Symbolica: its canonical form, its derivatives, its optimized evaluator, SymJIT
+    /// (needs the `symbolica` cargo feature).
+    Symbolica,
 }
 
 /// Arguments of `foldsynth bench vertex`.
@@ -66,9 +69,10 @@ pub struct VertexBenchArgs {
     /// Print one JSON object (times in nanoseconds, compile times in milliseconds).
     #[arg(long)]
     pub json: bool,
-    /// Also run a peer implementation in this invocation.
-    #[arg(long, value_enum)]
-    pub peer: Option<Peer>,
+    /// Also run peer implementations in this invocation (repeat or separate by commas:
+    /// `--peer casadi,symbolica`).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub peer: Vec<Peer>,
     /// The driving parameter at which to evaluate (default: the most rigid sample of
     /// (0, π), away from singular states).
     #[arg(long, allow_hyphen_values = true)]
@@ -204,9 +208,25 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     // and the fastest round is reported: interference from other processes only ever
     // adds time, so the minimum is the most repeatable estimate on a busy machine, and
     // all rows are treated alike.
-    let peer_setup = match args.peer {
-        Some(Peer::Casadi) => Some(casadi_setup(&args, &spec, t)?),
-        None => None,
+    let peer_setup = if args.peer.contains(&Peer::Casadi) {
+        Some(casadi_setup(&args, &spec, t)?)
+    } else {
+        None
+    };
+    let mut symbolica = if args.peer.contains(&Peer::Symbolica) {
+        let job = super::bench_symbolica::PeerJob {
+            graph: graph.clone(),
+            outputs: vec![("phi_sum".to_string(), out[0])],
+            names: model.names.clone(),
+            n_vars: model.n_vars,
+            n_params: model.n_params,
+        };
+        let inputs: Vec<f64> = vars.iter().chain(&params).copied().collect();
+        Some(super::bench_symbolica::SymbolicaPeer::new(
+            job, inputs, &buf, 3,
+        )?)
+    } else {
+        None
     };
     let rounds: u32 = 7;
     let slice = budget / rounds;
@@ -265,6 +285,9 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
                 black_box(&dparams),
             ));
         }));
+        if let Some(s) = &mut symbolica {
+            s.round(slice)?;
+        }
         if let Some(PeerSetup::Harness { argv, .. }) = &peer_setup
             && harness_error.is_none()
         {
@@ -401,6 +424,11 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
             o["peer_nan"] = json!(peer_nans);
             o["rigid_at_t"] = json!(rigid_here);
         }
+        if let Some(s) = &symbolica {
+            o["symbolica"] = s.json();
+            o["symbolica_value_grad_ratio"] = json!(jit_value_grad_ns / s.value_grad_ns());
+            o["symbolica_compile_ratio"] = json!(compile_ms / s.compile_ms());
+        }
         println!("{}", serde_json::to_string_pretty(&o)?);
         return verdict();
     }
@@ -444,6 +472,9 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
             println!("CasADi peer skipped: {msg}");
         }
     }
+    if let Some(s) = &symbolica {
+        row("Symbolica SymJIT (peer)", s.value_grad_ns());
+    }
     println!();
     println!("{:<44} {:>12.1}", "JIT value only (ns)", jit_value_ns);
     println!(
@@ -483,6 +514,12 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
             }
         ),
         None => {}
+    }
+    if let Some(s) = &symbolica {
+        println!();
+        for l in s.lines(jit_value_grad_ns, compile_ms) {
+            println!("{l}");
+        }
     }
     verdict()
 }

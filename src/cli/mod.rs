@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 pub mod bench;
 pub mod bench_model;
 pub mod bench_numeric;
+pub mod bench_symbolica;
 pub mod compile;
 pub mod enumerate;
 pub mod export;
