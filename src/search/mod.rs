@@ -13,4 +13,4 @@ mod record;
 mod run;
 
 pub use record::{AlternativeRecord, Summary, Timings, level_distribution};
-pub use run::{Alternative, SearchError, SearchOptions, prepare, run};
+pub use run::{Alternative, SearchError, SearchOptions, model_meta, prepare, run};

@@ -1,11 +1,11 @@
 //! Running a search: scheduling, streaming, resuming, summarizing, exporting.
 
-use super::record::{AlternativeRecord, Summary, Timings, level_distribution};
+use super::record::{AlternativeRecord, CyclicCounts, Summary, Timings, level_distribution};
 use crate::check::verify::{Tolerances, verify};
 use crate::check::{CheckError, Cylinder, MotionSettings, check_frames, two_armed};
 use crate::compile::Options as CompileOptions;
 use crate::export::{self, DesignMeta, ExportOptions};
-use crate::grammar::{CreaseGraph, Enumeration, Filters};
+use crate::grammar::{CreaseGraph, Enumeration, Filters, Rules};
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
 use crate::model::{Model, ModelError};
@@ -43,6 +43,8 @@ pub struct SearchOptions {
     pub export: bool,
     /// Show a progress bar on stderr (only drawn on a terminal).
     pub progress: bool,
+    /// The grammar's rules (default r1, r2; r2′ adds cyclic patterns).
+    pub rules: Rules,
 }
 
 impl Default for SearchOptions {
@@ -57,6 +59,7 @@ impl Default for SearchOptions {
             sweep: 181,
             export: true,
             progress: true,
+            rules: Rules::default(),
         }
     }
 }
@@ -251,6 +254,7 @@ fn evaluate(
         evaluations: sol.evaluations,
         optimize_ms,
         check_ms: 0.0,
+        cycle: None,
     };
     if !meets {
         return rec;
@@ -298,7 +302,7 @@ fn evaluate(
     let tol = Tolerances::default();
     let report = verify(&design, &sample_times(model.t_max, opts.sweep), &tol);
     let failed = !report.geometry_passes(&tol);
-    if failed {
+    if failed && model.plan.sinks.is_empty() {
         eprintln!(
             "BUG: verification failed for {} (graph {}): {}",
             rec.key,
@@ -306,7 +310,22 @@ fn evaluate(
             report.failures(&tol).join("; ")
         );
     }
-    rec.verification_failed = Some(failed);
+    if !model.plan.sinks.is_empty() {
+        // A cyclic design (r2′): the PTU's frames are only right where the cycle closes, so
+        // the sweep and the simulation decide; a geometric failure is a bug only then.
+        let verdict = crate::simulate::crossval::verify_cyclic(
+            model,
+            &design.vars,
+            &design.modes,
+            opts.sweep,
+            tol.geometry_margin,
+        );
+        let failed = failed && verdict.sweep.passes(crate::check::cycle::CYCLE_TOL);
+        rec.verification_failed = Some(failed);
+        rec.cycle = Some(verdict);
+    } else {
+        rec.verification_failed = Some(failed);
+    }
     rec.verification = Some(report);
     rec.check_ms = t1.elapsed().as_secs_f64() * 1e3;
     rec
@@ -354,7 +373,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     }
 
     let t0 = Instant::now();
-    let enumeration = Enumeration::run(task, n_max, Filters::all());
+    let enumeration = Enumeration::run_with(task, n_max, Filters::all(), opts.rules);
     let graphs: Vec<&CreaseGraph> = enumeration.meaningful().map(|n| &n.graph).collect();
     let enumerate_s = t0.elapsed().as_secs_f64();
 
@@ -378,10 +397,13 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     // The settings that decide the results: a resumed run must use the same ones, or its
     // records would mix two searches.
     let settings_path = opts.out.join("settings.json");
-    let settings = json!({
+    let mut settings = json!({
         "task": task.name, "n_max": n_max, "starts": opts.starts, "seed": opts.seed,
         "sweep": opts.sweep, "foldsynth": env!("CARGO_PKG_VERSION"),
     });
+    if opts.rules != Rules::default() {
+        settings["rules"] = json!(opts.rules.names());
+    }
     if opts.resume
         && let Ok(text) = fs::read_to_string(&settings_path)
         && let Ok(old) = serde_json::from_str::<serde_json::Value>(&text)
@@ -539,6 +561,12 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
             "sweep": opts.sweep, "resumed": finished.len(),
         }),
         designs: feasible.iter().map(|r| r.id()).collect(),
+        cyclic: opts.rules.r2p.then(|| {
+            CyclicCounts::count(
+                graphs.iter().filter(|g| g.is_cyclic_pattern()).count(),
+                &records,
+            )
+        }),
     };
 
     let t2 = Instant::now();
@@ -558,15 +586,21 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
 
 /// The export metadata of a design.
 fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMeta {
+    let mut meta = model_meta(task, model, &rec.modes, rec.objective);
+    meta.extra
+        .insert("candidate".to_string(), json!(rec.candidate));
+    meta.extra.insert("key".to_string(), json!(rec.key));
+    meta
+}
+
+/// The export metadata of a design of `model` with `modes` ("up"/"down") and objective
+/// Ω* (also for designs outside a search, e.g. `foldsynth model --save`).
+pub fn model_meta(task: &Task, model: &Model, modes: &[String], objective: f64) -> DesignMeta {
     let multi = model.targets.len() > 1;
-    let mut extra = BTreeMap::new();
-    extra.insert("candidate".to_string(), json!(rec.candidate));
-    extra.insert("key".to_string(), json!(rec.key));
     DesignMeta {
         task: task.name.clone(),
-        rule_sequence: rec.sequence.clone(),
-        modes: rec
-            .modes
+        rule_sequence: model.plan.sequence.clone(),
+        modes: modes
             .iter()
             .map(|m| {
                 if m == "up" {
@@ -577,7 +611,7 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
             })
             .collect(),
         gripping_vertex: Some(model.gripping),
-        objective: Some(rec.objective),
+        objective: Some(objective),
         targets: model
             .targets
             .iter()
@@ -596,7 +630,7 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
             .as_ref()
             .and_then(|c| c.cylinders.first().copied()),
         second_arm: task.check.as_ref().is_some_and(|c| c.second_arm),
-        extra,
+        extra: BTreeMap::new(),
     }
 }
 
