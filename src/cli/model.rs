@@ -169,7 +169,16 @@ pub fn run(args: ModelArgs) -> Result<()> {
             ..Default::default()
         };
         let t0 = std::time::Instant::now();
-        let sol = crate::optimize::minimize(&problem, &opts);
+        let mut sol = crate::optimize::minimize(&problem, &opts);
+        // Cyclic patterns: Newton on the compatibility equations, to rounding.
+        crate::model::cycle::polish_solution(
+            &problem,
+            &model,
+            &modes,
+            &mut sol,
+            opts.feasibility_tol,
+            opts.target,
+        );
         eprintln!(
             "optimized in {:.1} ms: {} starts, {} evaluations, feasible {}, target met {}",
             t0.elapsed().as_secs_f64() * 1e3,
@@ -390,6 +399,21 @@ fn print_cycle(c: &CyclicVerdict, t_max: f64) {
     println!(
         "  positions through every facet, max disagreement {:.3e}  (t = {:.6})",
         s.position_max, s.position_t
+    );
+    println!(
+        "  largest fold-angle change between states      {:.3e}  (after t = {:.6}; at most {} for one continuous motion)",
+        s.jump_max,
+        s.jump_t,
+        crate::check::cycle::JUMP_TOL
+    );
+    println!(
+        "  largest fold angle of the straight crease        {:.3e}{}",
+        s.shared_fold_max,
+        if s.folds_shared_crease() {
+            ""
+        } else {
+            "  (it never folds: the cycle closes trivially)"
+        }
     );
     match (&c.simulation, &c.error) {
         (Some(r), _) => println!(

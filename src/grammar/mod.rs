@@ -58,6 +58,17 @@
 //!   image equals an earlier graph that was kept); then validity. A graph without an
 //!   extended vertex has no gripping vertex and is invalid.
 //!
+//! # Rule r2′ (Sec. 5.7, Fig. 52b)
+//!
+//! [`CreaseGraph::combine_straight`] combines two χ vertices like r2 but replaces them by a
+//! sink v′ on the straight segment between their predecessors (the thesis leaves the rule a
+//! sketch; our readings): it matches where r2 does, with one predecessor each, neither in
+//! G0, the predecessors not joined by a crease; v′ sits at the midpoint (any point of the
+//! segment gives the same kinematics; the midpoint adds no variable); the two facets on
+//! the far side of the straight crease become one. It is recorded as an [`R2Record`] with
+//! [`Straight`] set and written `(a, b)'`. The enumeration applies it only when asked
+//! ([`Rules`]), after r2's matches, so the thesis's counts below stay.
+//!
 //! # Counts (gripper and robotic arm, G0 of Fig. 40)
 //!
 //! Without filters N_max = 3 gives exactly the thesis's 291 graphs (G0, the root, not

@@ -213,6 +213,9 @@ pub struct CyclicCounts {
     pub simulation_agrees: usize,
     /// Feasible designs from cyclic graphs.
     pub feasible: usize,
+    /// … of those, whose straight crease through the sink folds (the others close the
+    /// cycle trivially: that crease stays flat).
+    pub feasible_folding_shared_crease: usize,
 }
 
 impl CyclicCounts {
@@ -236,6 +239,12 @@ impl CyclicCounts {
                 .filter(|r| verdict(r).is_some_and(|v| v.simulation.is_some_and(|s| s.agrees)))
                 .count(),
             feasible: cyc.iter().filter(|r| r.feasible_design()).count(),
+            feasible_folding_shared_crease: cyc
+                .iter()
+                .filter(|r| {
+                    r.feasible_design() && verdict(r).is_some_and(|v| v.sweep.folds_shared_crease())
+                })
+                .count(),
         }
     }
 }
@@ -297,14 +306,15 @@ impl Summary {
         );
         if let Some(c) = &self.cyclic {
             s += &format!(
-                "  from cyclic graphs (r2′): {} graphs, {} alternatives, {} meet the target, {} also clear, {} pass the compatibility sweep, {} agree with the simulation, {} feasible\n",
+                "  from cyclic graphs (r2′): {} graphs, {} alternatives, {} meet the target, {} also clear, {} pass the compatibility sweep, {} agree with the simulation, {} feasible ({} fold the shared crease)\n",
                 c.graphs,
                 c.alternatives,
                 c.meets_target,
                 c.no_intersection,
                 c.sweep_passes,
                 c.simulation_agrees,
-                c.feasible
+                c.feasible,
+                c.feasible_folding_shared_crease
             );
         }
         s += &format!(

@@ -209,14 +209,21 @@ fn evaluate(
     let key = alt.key();
     let t0 = Instant::now();
     let problem = ModelProblem::new(model, &p.compiled, &modes);
-    let sol = minimize(
+    let optimize_opts = optimize::Options {
+        starts: opts.starts,
+        seed: alternative_seed(opts.seed, &key),
+        target: Some(objective_target(model)),
+        ..Default::default()
+    };
+    let mut sol = minimize(&problem, &optimize_opts);
+    // Cyclic patterns: Newton on the compatibility equations, to rounding.
+    crate::model::cycle::polish_solution(
         &problem,
-        &optimize::Options {
-            starts: opts.starts,
-            seed: alternative_seed(opts.seed, &key),
-            target: Some(objective_target(model)),
-            ..Default::default()
-        },
+        model,
+        &modes,
+        &mut sol,
+        optimize_opts.feasibility_tol,
+        optimize_opts.target,
     );
     let optimize_ms = t0.elapsed().as_secs_f64() * 1e3;
     let full = model.full_vars(&sol.x);
