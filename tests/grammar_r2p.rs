@@ -110,7 +110,11 @@ fn should_match(g: &CreaseGraph, c1: Vid, c2: Vid) -> bool {
     let (p1, p2) = (e1.tail, e2.tail);
     let joined = g
         .creases()
-        .any(|c| (c.tail == p1 && c.head == p2) || (c.tail == p2 && c.head == p1));
+        .any(|c| (c.tail == p1 && c.head == p2) || (c.tail == p2 && c.head == p1))
+        || g.sinks().any(|v| {
+            let [a, b] = v.sink_between.unwrap();
+            (a, b) == (p1, p2) || (a, b) == (p2, p1)
+        });
     let (fa, fb) = (e1.left, e2.right);
     let merge = |f| if f == fb { fa } else { f };
     let looped = g.creases().any(|c| merge(c.left) == merge(c.right));
@@ -150,7 +154,7 @@ fn r2p_applies_exactly_where_its_match_holds() {
         }
     }
     assert!(
-        yes >= 40 && no > 100 * yes,
+        yes >= 20 && no > 100 * yes,
         "{yes} matches, {no} non-matches"
     );
 }
@@ -161,7 +165,7 @@ fn primed_pairs_round_trip() {
     for text in [
         "2, 3, 4, 8, (9, 14)'",
         "2, 3, 4, (8, 9)'",
-        "2, 3, 4, (8, 9)', (7, 9)'",
+        "2, 3, 4, (8, 9)', (7, 9)",
         "2, 3, 8, (7, 9), (4, 10)', (5, 9)",
     ] {
         let steps = parse_sequence(text).unwrap();
@@ -217,6 +221,8 @@ fn bad_r2p_steps_say_why() {
         ("2, 3, (1, 4)'", "v1 is not extendable"),
         // v4 and v8: their predecessors v2 and v3 are joined by the crease v2 → v3.
         ("2, 3, (4, 8)'", "joined by a crease"),
+        // A second sink between v3 and v4 would lie on the first one's straight crease.
+        ("2, 3, 4, (8, 9)', (7, 9)'", "v4 and v3 are joined by a crease already"),
         ("2, 3, (4, 99)'", "there is no vertex v99"),
     ] {
         let err = CreaseGraph::from_sequence(&task, text)
@@ -387,6 +393,15 @@ fn filters_treat_cyclic_graphs_as_the_old_ones() {
         "{pairs} {equal} {mirrored}"
     );
 
+    // Every graph, cyclic or not, gives a model plan (its facets are simple polygons).
+    for gr in &graphs {
+        assert!(
+            foldsynth::model::Plan::new(gr).is_ok(),
+            "{}: {:?}",
+            gr.sequence(),
+            foldsynth::model::Plan::new(gr).err()
+        );
+    }
     // N_max = 4: the first level where cyclic graphs fall to every filter.
     let f = Enumeration::run_with(&task, 4, Filters::all(), Rules::all());
     let mut kept = HashSet::new();
@@ -481,6 +496,7 @@ proptest! {
         for v in gr.variables() {
             prop_assert_eq!(gr.is_free(v.id), !eliminated.contains(&v.id), "{} {}", gr.sequence(), v.name);
         }
+        prop_assert!(foldsynth::model::Plan::new(&gr).is_ok(), "{}: {:?}", gr.sequence(), foldsynth::model::Plan::new(&gr).err());
         let h = CreaseGraph::from_sequence(&task, &gr.sequence()).unwrap();
         prop_assert_eq!(h.canonical_code(), gr.canonical_code());
     }

@@ -11,7 +11,8 @@
 //! and the sink closes a real facet:
 //! - each has exactly one predecessor (p1 of c1, p2 of c2);
 //! - neither is in G0 (a G0 vertex has fixed coordinates, not the midpoint);
-//! - p1 and p2 are not joined by a crease (the shared facet would collapse to the segment);
+//! - p1 and p2 are not joined by a crease, nor by an earlier sink's straight crease (the
+//!   shared facet would collapse onto the segment, or two creases would coincide);
 //! - merging the two far-side facets does not put one facet on both sides of a crease.
 //!
 //! **Transformation** — a new sink v′ (type ∅, no outgoing creases, predecessors p1, p2)
@@ -71,9 +72,15 @@ impl CreaseGraph {
         }
         let (e1, e2) = (self.cr(a.preds[0]), self.cr(b.preds[0]));
         let (p1, p2) = (e1.tail, e2.tail);
+        // A crease p1–p2, or an earlier sink's straight crease between them (a second one
+        // would lie on top of it).
         if self
             .creases()
             .any(|c| (c.tail == p1 && c.head == p2) || (c.tail == p2 && c.head == p1))
+            || self.sinks().any(|v| {
+                v.sink_between
+                    .is_some_and(|[a, b]| (a == p1 && b == p2) || (a == p2 && b == p1))
+            })
         {
             return Err(NoR2p::Joined(p1, p2));
         }
@@ -121,7 +128,7 @@ impl CreaseGraph {
                 self.vname(v)
             ),
             NoR2p::Joined(p, q) => format!(
-                "{head}: their predecessors {} and {} are joined by a crease (the shared facet would collapse onto it)",
+                "{head}: their predecessors {} and {} are joined by a crease already (the shared facet would collapse onto it)",
                 self.vname(p),
                 self.vname(q)
             ),
