@@ -222,7 +222,10 @@ fn bad_r2p_steps_say_why() {
         // v4 and v8: their predecessors v2 and v3 are joined by the crease v2 → v3.
         ("2, 3, (4, 8)'", "joined by a crease"),
         // A second sink between v3 and v4 would lie on the first one's straight crease.
-        ("2, 3, 4, (8, 9)', (7, 9)'", "v4 and v3 are joined by a crease already"),
+        (
+            "2, 3, 4, (8, 9)', (7, 9)'",
+            "v4 and v3 are joined by a crease already",
+        ),
         ("2, 3, (4, 99)'", "there is no vertex v99"),
     ] {
         let err = CreaseGraph::from_sequence(&task, text)
