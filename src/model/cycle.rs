@@ -307,7 +307,8 @@ pub fn polish_solution<P: crate::optimize::Problem>(
     let mut e = crate::optimize::Evaluation::new(problem.n_vars(), problem.n_constraints());
     problem.eval(&x, &mut e);
     let violation = e.violation();
-    if !(violation <= sol.violation.max(feasibility_tol)) {
+    // A NaN violation (a polish gone astray) keeps the optimizer's point too.
+    if violation.is_nan() || violation > sol.violation.max(feasibility_tol) {
         return;
     }
     sol.feasible = violation <= feasibility_tol && e.f.is_finite();
