@@ -207,6 +207,8 @@ impl Task {
             sweep,
             export,
             progress: false,
+            // The thesis's rules (r1, r2); r2′ is the CLI's `--rules r1,r2,r2p`.
+            ..SearchOptions::default()
         };
         let task = &self.task;
         let summary = py.detach(|| search::run(task, &opts)).map_err(fs_err)?;

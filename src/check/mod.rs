@@ -6,7 +6,8 @@
 //!   thesis Sec. 3.2.4;
 //! * [`cylinder`] — the finite-cylinder obstacle of the gripper task (Sec. 5.5);
 //! * [`motion`] — the flat layout and evenly spaced states of a motion (16 in the thesis);
-//! * [`rotated_copy`] — the two-armed gripper built from one arm.
+//! * [`rotated_copy`] — the two-armed gripper built from one arm;
+//! * [`cycle`] — cyclic designs (r2′): compatibility and position agreement over a sweep.
 //!
 //! ```
 //! use foldsynth::check::{Checker, MotionSettings, check_motion};
@@ -25,6 +26,7 @@
 //! assert!(!bad.self_intersection_free());
 //! ```
 
+pub mod cycle;
 pub mod cylinder;
 pub mod motion;
 pub mod rotated_copy;

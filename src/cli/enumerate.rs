@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use serde::Serialize;
 
-use crate::grammar::{Enumeration, Filters, Status};
+use crate::grammar::{Enumeration, Filters, Rules, Status};
 use crate::limits::{GRAPHS_MAX, N_MAX};
 use crate::task::Task;
 
@@ -42,6 +42,9 @@ pub struct EnumerateArgs {
     /// Write the search tree (Fig. 48) as Graphviz DOT to this file.
     #[arg(long, value_name = "FILE.dot")]
     pub tree: Option<PathBuf>,
+    /// The grammar's rules: r1,r2 (the thesis's, default) or r1,r2,r2p (with r2′).
+    #[arg(long, default_value = "r1,r2", value_name = "RULES")]
+    pub rules: Rules,
 }
 
 #[derive(Serialize)]
@@ -61,14 +64,43 @@ struct GraphEntry {
     parent: Option<usize>,
     /// 2^N × 3 for meaningful graphs, else 0.
     alternatives: u64,
+    /// Closed a cycle by r2′ (only listed with r2′ enabled).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cyclic: Option<bool>,
 }
 
 #[derive(Serialize)]
 struct Report {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rules: Option<String>,
     generated: usize,
     filtered: Filtered,
     alternatives: u64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cyclic: Option<CyclicSummary>,
     graphs: Vec<GraphEntry>,
+}
+
+/// With r2′: the cyclic share of the language.
+#[derive(Serialize)]
+struct CyclicSummary {
+    generated: usize,
+    meaningful: usize,
+    alternatives: u64,
+}
+
+fn cyclic_summary(e: &Enumeration) -> Option<CyclicSummary> {
+    e.rules.r2p.then(|| {
+        let cyc = || e.nodes.iter().filter(|n| n.graph.is_cyclic_pattern());
+        CyclicSummary {
+            generated: cyc().count(),
+            meaningful: cyc().filter(|n| n.status == Status::Meaningful).count(),
+            alternatives: cyc()
+                .filter(|n| n.status == Status::Meaningful)
+                .map(|n| n.graph.alternatives())
+                .sum(),
+        }
+    })
 }
 
 /// Run `foldsynth enumerate`.
@@ -82,7 +114,7 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
     };
     // Every generated graph is kept (about 15 kB each): what does not fit the budget is
     // refused with its estimated size, before memory runs out.
-    let e = Enumeration::run_within(&task, n_max, filters, GRAPHS_MAX)
+    let e = Enumeration::run_within_with(&task, n_max, filters, args.rules, GRAPHS_MAX)
         .map_err(|est| anyhow::anyhow!("{}", est.refusal(&task.name, n_max, filters)))?;
     if let Some(path) = &args.tree {
         std::fs::write(path, e.to_dot())
@@ -91,6 +123,8 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
     match args.format {
         Format::Json => {
             let report = Report {
+                rules: e.rules.r2p.then(|| e.rules.names()),
+                cyclic: cyclic_summary(&e),
                 generated: e.nodes.len(),
                 filtered: Filtered {
                     isomorphic: e.count(Status::Isomorphic),
@@ -112,6 +146,7 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
                         } else {
                             0
                         },
+                        cyclic: e.rules.r2p.then(|| n.graph.is_cyclic_pattern()),
                     })
                     .collect(),
             };
@@ -148,6 +183,9 @@ fn text_report(task: &Task, e: &Enumeration, args: &EnumerateArgs) -> String {
         mirror,
         on(e.filters.validity)
     );
+    if e.rules != Rules::default() {
+        let _ = writeln!(s, "rules: {}", e.rules.names().replace("r2p", "r2′"));
+    }
     let _ = writeln!(s);
     let _ = writeln!(
         s,
@@ -188,6 +226,13 @@ fn text_report(task: &Task, e: &Enumeration, args: &EnumerateArgs) -> String {
         "design alternatives: {} (sum over meaningful graphs of 2^N RBM assignments x 3 gripping candidates)",
         e.alternatives()
     );
+    if let Some(c) = cyclic_summary(e) {
+        let _ = writeln!(
+            s,
+            "cyclic graphs (closed by r2′): {} generated, {} meaningful, {} alternatives",
+            c.generated, c.meaningful, c.alternatives
+        );
+    }
     if let Some(t) = &args.tree {
         let _ = writeln!(s, "search tree written to {}", t.display());
     }

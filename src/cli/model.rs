@@ -9,6 +9,7 @@ use crate::grammar::{CreaseGraph, VarKind};
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
 use crate::model::{Model, Plan};
+use crate::simulate::crossval::{CyclicVerdict, verify_cyclic};
 use crate::task::Task;
 use anyhow::{Context, Result, bail};
 use serde_json::json;
@@ -64,6 +65,11 @@ pub struct ModelArgs {
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
+    /// Write the design (variables, verification, pattern with 33 frames, metadata) to
+    /// this JSON file, as `synthesize` writes `designs/<id>.json`: `foldsynth export` and
+    /// `foldsynth simulate` read it.
+    #[arg(long, value_name = "DESIGN.json")]
+    pub save: Option<PathBuf>,
 }
 
 /// Parse "up,down,…" into ±1 for `n` internal vertices.
@@ -186,7 +192,16 @@ pub fn run(args: ModelArgs) -> Result<()> {
             ..Default::default()
         };
         let t0 = std::time::Instant::now();
-        let sol = crate::optimize::minimize(&problem, &opts);
+        let mut sol = crate::optimize::minimize(&problem, &opts);
+        // Cyclic patterns: Newton on the compatibility equations, to rounding.
+        crate::model::cycle::polish_solution(
+            &problem,
+            &model,
+            &modes,
+            &mut sol,
+            opts.feasibility_tol,
+            opts.target,
+        );
         eprintln!(
             "optimized in {:.1} ms: {} starts, {} evaluations, feasible {}, target met {}",
             t0.elapsed().as_secs_f64() * 1e3,
@@ -208,6 +223,28 @@ pub fn run(args: ModelArgs) -> Result<()> {
         &sample_times(model.t_max, args.sweep.max(2)),
         &Tolerances::default(),
     );
+    // A cyclic pattern (r2′): the compatibility sweep and the bar-and-hinge simulation.
+    let cycle = (!model.plan.sinks.is_empty()).then(|| {
+        verify_cyclic(
+            &model,
+            &full,
+            &modes,
+            args.sweep.max(2),
+            Tolerances::default().geometry_margin,
+        )
+    });
+    if let Some(path) = &args.save {
+        save_design(
+            path,
+            &task,
+            &model,
+            &x,
+            &modes,
+            omega,
+            &report,
+            cycle.as_ref(),
+        )?;
+    }
     let rep = &compiled.compiled.report;
     let layout = &compiled.compiled.layout;
     let constraint_values: Vec<f64> = (0..compiled.n_constraints)
@@ -248,6 +285,10 @@ pub fn run(args: ModelArgs) -> Result<()> {
             "compile_ms": compiled.total_ms,
             "verification": report,
         });
+        let mut out = out;
+        if let Some(c) = &cycle {
+            out["cycle"] = json!(c);
+        }
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
@@ -331,7 +372,122 @@ pub fn run(args: ModelArgs) -> Result<()> {
         "  rigid over the motion {}  (at t_max: {}; smallest margin {:.3e} at t = {:.6})",
         report.rigid_over_motion, report.rigid_at_tmax, report.min_margin, report.min_margin_t
     );
+    if let Some(c) = &cycle {
+        print_cycle(c, model.t_max);
+    }
+    if let Some(path) = &args.save {
+        println!("\ndesign written to {}", path.display());
+    }
     Ok(())
+}
+
+/// The verdict on a cyclic design, in words.
+fn print_cycle(c: &CyclicVerdict, t_max: f64) {
+    let s = &c.sweep;
+    println!(
+        "\ncyclic pattern ({} r2′ sink{}): compatibility over {} states in [0, {t_max:.6}] ({} rigid):",
+        s.sinks,
+        if s.sinks == 1 { "" } else { "s" },
+        s.states,
+        s.checked_states
+    );
+    println!(
+        "  dihedral angles from both ends, max difference  {:.3e}  (t = {:.6})",
+        s.compatibility_max, s.compatibility_t
+    );
+    println!(
+        "  positions through every facet, max disagreement {:.3e}  (t = {:.6})",
+        s.position_max, s.position_t
+    );
+    println!(
+        "  largest fold-angle change between states      {:.3e}  (after t = {:.6}; at most {} for one continuous motion)",
+        s.jump_max,
+        s.jump_t,
+        crate::check::cycle::JUMP_TOL
+    );
+    println!(
+        "  largest fold angle of the straight crease        {:.3e}{}",
+        s.shared_fold_max,
+        if s.folds_shared_crease() {
+            ""
+        } else {
+            "  (it never folds: the cycle closes trivially)"
+        }
+    );
+    match (&c.simulation, &c.error) {
+        (Some(r), _) => println!(
+            "  bar-and-hinge simulation ({} steps, driven by G0's crease): Γ = {:.3e}, max δ = {:.3e}, max |x − X_PTU| = {:.3e}: {}",
+            r.steps,
+            r.gamma,
+            r.max_delta,
+            r.max_position_error,
+            if r.agrees { "agrees" } else { "DISAGREES" }
+        ),
+        (None, Some(e)) => println!("  bar-and-hinge simulation failed: {e}"),
+        (None, None) => println!("  bar-and-hinge simulation not run: the sweep failed"),
+    }
+    println!(
+        "  verdict: {}",
+        if c.passes {
+            "folds rigidly (both verifications pass)"
+        } else {
+            "does not fold rigidly over the whole motion"
+        }
+    );
+}
+
+/// Write a design file (see [`ModelArgs::save`]).
+#[allow(clippy::too_many_arguments)]
+fn save_design(
+    path: &Path,
+    task: &Task,
+    model: &Model,
+    x: &[f64],
+    modes: &[f64],
+    omega: f64,
+    report: &crate::check::verify::VerifyReport,
+    cycle: Option<&CyclicVerdict>,
+) -> Result<()> {
+    let names: Vec<String> = modes
+        .iter()
+        .map(|m| if *m > 0.0 { "up" } else { "down" }.to_string())
+        .collect();
+    let full = model.full_vars(x);
+    let design = Evaluated::new(&model.plan, full.clone(), modes.to_vec());
+    let pattern = design.pattern(&sample_times(model.t_max, 33));
+    let mut meta = crate::search::model_meta(task, model, &names, omega);
+    meta.extra
+        .insert("candidate".into(), json!(model.candidate + 1));
+    let variables: std::collections::BTreeMap<&str, f64> = model
+        .free
+        .iter()
+        .zip(x)
+        .map(|(&i, v)| (model.plan.variables[i].name.as_str(), *v))
+        .collect();
+    let all: std::collections::BTreeMap<&str, f64> = model
+        .plan
+        .variables
+        .iter()
+        .zip(&full)
+        .map(|(v, x)| (v.name.as_str(), *x))
+        .collect();
+    let doc = json!({
+        "task": task.name,
+        "sequence": model.plan.sequence,
+        "candidate": model.candidate + 1,
+        "gripping_vertex": model.plan.vertices[model.gripping].name,
+        "modes": names,
+        "objective": omega,
+        "threshold": model.threshold,
+        "variables": variables,
+        "all_variables": all,
+        "verification": report,
+        "cycle": cycle,
+        "pattern": pattern,
+        "meta": meta,
+    });
+    std::fs::write(path, serde_json::to_string_pretty(&doc)?)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 fn kind(k: VarKind) -> &'static str {

@@ -47,6 +47,10 @@ pub struct SynthesizeArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
+    /// The grammar's rules: r1,r2 (the thesis's, default) or r1,r2,r2p (with r2′: cyclic,
+    /// overconstrained patterns such as the Miura-ori, verified by simulation).
+    #[arg(long, default_value = "r1,r2", value_name = "RULES")]
+    pub rules: crate::grammar::Rules,
 }
 
 /// Run `foldsynth synthesize`.
@@ -64,6 +68,7 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         sweep: args.sweep,
         export: !args.no_export,
         progress: true,
+        rules: args.rules,
     };
     let summary = search::run(&task, &opts)?;
     let files = format!(

@@ -2,7 +2,8 @@
 //!
 //! Breadth-first by number of rule applications. From every graph that is expanded, the
 //! r1 matches (while N < N_max) in increasing vertex name, then the r2 matches in
-//! increasing sorted name pairs, each give one child. Every child gets one status:
+//! increasing sorted name pairs, then (only when [`Rules::r2p`] is on) the r2′ matches in
+//! the same order, each give one child. Every child gets one status:
 //!
 //! - `isomorphic`: the same design family as an earlier graph (canonical code, see
 //!   [`Code`](super::Code)); not expanded.
@@ -51,6 +52,89 @@ impl Filters {
             mirror: false,
             validity: false,
         }
+    }
+}
+
+/// Which rules the enumeration applies. The thesis's grammar is r1 and r2 (the default);
+/// r2′ (Sec. 5.7) is opt-in, so the thesis's counts stay what they are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Rules {
+    /// r1: extend a vertex.
+    pub r1: bool,
+    /// r2: combine two vertices.
+    pub r2: bool,
+    /// r2′: combine two vertices into a sink on the straight segment between their
+    /// predecessors (cyclic, overconstrained patterns such as the Miura-ori).
+    pub r2p: bool,
+}
+
+impl Default for Rules {
+    fn default() -> Self {
+        Rules {
+            r1: true,
+            r2: true,
+            r2p: false,
+        }
+    }
+}
+
+impl Rules {
+    /// Every rule, r2′ included.
+    pub fn all() -> Rules {
+        Rules {
+            r1: true,
+            r2: true,
+            r2p: true,
+        }
+    }
+
+    /// Read a comma-separated list such as `r1,r2,r2p` (`r2'` and `r2′` name r2′ too).
+    pub fn parse(text: &str) -> Result<Rules, String> {
+        let mut r = Rules {
+            r1: false,
+            r2: false,
+            r2p: false,
+        };
+        for name in text.split(',').map(str::trim) {
+            match name {
+                "r1" => r.r1 = true,
+                "r2" => r.r2 = true,
+                "r2p" | "r2'" | "r2′" => r.r2p = true,
+                "" => {
+                    return Err(format!(
+                        "\"{text}\": an empty rule name; list rules as r1,r2,r2p"
+                    ));
+                }
+                other => {
+                    return Err(format!(
+                        "\"{other}\" is not a rule; the rules are r1, r2 and r2p (r2′)"
+                    ));
+                }
+            }
+        }
+        if !r.r1 {
+            return Err(format!(
+                "\"{text}\": r1 must be among the rules (without it no vertex is ever extended)"
+            ));
+        }
+        Ok(r)
+    }
+
+    /// The list as [`Rules::parse`] reads it, e.g. `r1,r2,r2p`.
+    pub fn names(&self) -> String {
+        [(self.r1, "r1"), (self.r2, "r2"), (self.r2p, "r2p")]
+            .iter()
+            .filter(|(on, _)| *on)
+            .map(|(_, n)| *n)
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+}
+
+impl std::str::FromStr for Rules {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Rules, String> {
+        Rules::parse(s)
     }
 }
 
@@ -123,6 +207,8 @@ pub struct Enumeration {
     pub filters: Filters,
     /// Whether the mirror filter actually ran (requested and the task is mirror-symmetric).
     pub mirror_applied: bool,
+    /// The rules applied.
+    pub rules: Rules,
 }
 
 /// The search tree grew past the graph budget given to [`Enumeration::run_limited`].
@@ -224,6 +310,25 @@ impl Enumeration {
         filters: Filters,
         max_graphs: usize,
     ) -> Result<Enumeration, TooLarge> {
+        Self::run_limited_with(task, n_max, filters, Rules::default(), max_graphs)
+    }
+
+    /// As [`Enumeration::run`] with a choice of rules (r2′ adds its matches after r2's).
+    pub fn run_with(task: &Task, n_max: usize, filters: Filters, rules: Rules) -> Enumeration {
+        match Self::run_limited_with(task, n_max, filters, rules, usize::MAX) {
+            Ok(e) => e,
+            Err(e) => unreachable!("no budget, yet {e}"),
+        }
+    }
+
+    /// As [`Enumeration::run_limited`] with a choice of rules.
+    pub fn run_limited_with(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        rules: Rules,
+        max_graphs: usize,
+    ) -> Result<Enumeration, TooLarge> {
         let root = CreaseGraph::initial(task);
         let mirror_applied =
             filters.mirror && task.symmetry.mirror_xz && root.initial_graph().mirror.is_some();
@@ -239,15 +344,27 @@ impl Enumeration {
             for parent in frontier {
                 let g = parent.map_or(&root, |i| &nodes[i].graph);
                 let mut children = Vec::new();
-                for v in g.r1_matches(n_max) {
-                    let mut c = g.clone();
-                    c.extend(v).expect("r1 matches what r1_matches found");
-                    children.push(c);
+                if rules.r1 {
+                    for v in g.r1_matches(n_max) {
+                        let mut c = g.clone();
+                        c.extend(v).expect("r1 matches what r1_matches found");
+                        children.push(c);
+                    }
                 }
-                for (_, m) in g.r2_matches() {
-                    let mut c = g.clone();
-                    c.combine(m).expect("r2 matches what r2_matches found");
-                    children.push(c);
+                if rules.r2 {
+                    for (_, m) in g.r2_matches() {
+                        let mut c = g.clone();
+                        c.combine(m).expect("r2 matches what r2_matches found");
+                        children.push(c);
+                    }
+                }
+                if rules.r2p {
+                    for (_, m) in g.r2p_matches() {
+                        let mut c = g.clone();
+                        c.combine_straight(m)
+                            .expect("r2′ matches what r2p_matches found");
+                        children.push(c);
+                    }
                 }
                 if nodes.len() + children.len() > max_graphs {
                     return Err(TooLarge {
@@ -293,6 +410,7 @@ impl Enumeration {
             n_max,
             filters,
             mirror_applied,
+            rules,
         })
     }
 
@@ -306,9 +424,20 @@ impl Enumeration {
         filters: Filters,
         max_graphs: usize,
     ) -> Result<Enumeration, GraphEstimate> {
+        Self::run_within_with(task, n_max, filters, Rules::default(), max_graphs)
+    }
+
+    /// As [`Enumeration::run_within`] with a choice of rules.
+    pub fn run_within_with(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        rules: Rules,
+        max_graphs: usize,
+    ) -> Result<Enumeration, GraphEstimate> {
         let mut measured = Vec::new();
         for k in 1..n_max {
-            match Self::run_limited(task, k, filters, max_graphs) {
+            match Self::run_limited_with(task, k, filters, rules, max_graphs) {
                 Ok(e) => measured.push((k, e.nodes.len())),
                 Err(_) => return Err(GraphEstimate::extrapolate(measured, n_max)),
             }
@@ -317,7 +446,7 @@ impl Enumeration {
         if estimate.graphs > 2.0 * max_graphs as f64 {
             return Err(estimate);
         }
-        Self::run_limited(task, n_max, filters, max_graphs).map_err(|_| estimate)
+        Self::run_limited_with(task, n_max, filters, rules, max_graphs).map_err(|_| estimate)
     }
 
     /// The generated graph with this rule sequence, if it was generated.

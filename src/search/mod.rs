@@ -19,4 +19,4 @@ mod run;
 
 pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
 pub use record::{AlternativeRecord, Summary, Timings, level_distribution};
-pub use run::{Alternative, SearchError, SearchOptions, prepare, run};
+pub use run::{Alternative, SearchError, SearchOptions, model_meta, prepare, run};

@@ -51,6 +51,9 @@ pub struct RunSettings {
     pub sweep: usize,
     /// foldsynth's version.
     pub foldsynth: String,
+    /// Grammar rules when not the default `r1,r2` (e.g. `r1,r2,r2p`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rules: Option<String>,
 }
 
 impl RunSettings {

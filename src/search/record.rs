@@ -60,6 +60,10 @@ pub struct AlternativeRecord {
     pub optimize_ms: f64,
     /// Milliseconds checking and verifying.
     pub check_ms: f64,
+    /// For designs of cyclic graphs (r2′) that meet the target: the dense compatibility
+    /// sweep and the bar-and-hinge simulation, which decide whether the design folds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle: Option<crate::simulate::crossval::CyclicVerdict>,
 }
 
 impl AlternativeRecord {
@@ -80,6 +84,12 @@ impl AlternativeRecord {
                 .as_ref()
                 .is_some_and(|v| v.rigid_over_motion)
             && self.verification_failed == Some(false)
+            && self.cycle.as_ref().is_none_or(|c| c.passes)
+    }
+
+    /// Whether the design comes from a cyclic graph (an r2′ step in its sequence).
+    pub fn is_cyclic(&self) -> bool {
+        self.sequence.contains(")'")
     }
 
     /// A file-name-safe identifier.
@@ -181,6 +191,62 @@ pub struct Summary {
     pub settings: serde_json::Value,
     /// Ids of the feasible designs.
     pub designs: Vec<String>,
+    /// With r2′ enabled: what came from cyclic graphs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cyclic: Option<CyclicCounts>,
+}
+
+/// The share of a search that comes from cyclic graphs (r2′).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct CyclicCounts {
+    /// Meaningful cyclic graphs.
+    pub graphs: usize,
+    /// Their alternatives evaluated.
+    pub alternatives: usize,
+    /// … meeting the target at the optimizer's states.
+    pub meets_target: usize,
+    /// … also free of intersections (the thesis's feasibility).
+    pub no_intersection: usize,
+    /// … whose compatibility sweep passes (residual and positions ≤ 1e-9).
+    pub sweep_passes: usize,
+    /// … whose bar-and-hinge simulation agrees (Γ ≤ 1e-8, positions).
+    pub simulation_agrees: usize,
+    /// Feasible designs from cyclic graphs.
+    pub feasible: usize,
+    /// … of those, whose straight crease through the sink folds (the others close the
+    /// cycle trivially: that crease stays flat).
+    pub feasible_folding_shared_crease: usize,
+}
+
+impl CyclicCounts {
+    /// Count the cyclic records among `records`.
+    pub fn count(graphs: usize, records: &[AlternativeRecord]) -> CyclicCounts {
+        let cyc: Vec<&AlternativeRecord> = records.iter().filter(|r| r.is_cyclic()).collect();
+        let verdict = |r: &&&AlternativeRecord| r.cycle.clone();
+        CyclicCounts {
+            graphs,
+            alternatives: cyc.len(),
+            meets_target: cyc.iter().filter(|r| r.meets_target).count(),
+            no_intersection: cyc.iter().filter(|r| r.thesis_feasible()).count(),
+            sweep_passes: cyc
+                .iter()
+                .filter(|r| {
+                    verdict(r).is_some_and(|v| v.sweep.passes(crate::check::cycle::CYCLE_TOL))
+                })
+                .count(),
+            simulation_agrees: cyc
+                .iter()
+                .filter(|r| verdict(r).is_some_and(|v| v.simulation.is_some_and(|s| s.agrees)))
+                .count(),
+            feasible: cyc.iter().filter(|r| r.feasible_design()).count(),
+            feasible_folding_shared_crease: cyc
+                .iter()
+                .filter(|r| {
+                    r.feasible_design() && verdict(r).is_some_and(|v| v.sweep.folds_shared_crease())
+                })
+                .count(),
+        }
+    }
 }
 
 impl Summary {
@@ -238,6 +304,19 @@ impl Summary {
             "  verification failures (bugs): {}\n",
             self.verification_failures
         );
+        if let Some(c) = &self.cyclic {
+            s += &format!(
+                "  from cyclic graphs (r2′): {} graphs, {} alternatives, {} meet the target, {} also clear, {} pass the compatibility sweep, {} agree with the simulation, {} feasible ({} fold the shared crease)\n",
+                c.graphs,
+                c.alternatives,
+                c.meets_target,
+                c.no_intersection,
+                c.sweep_passes,
+                c.simulation_agrees,
+                c.feasible,
+                c.feasible_folding_shared_crease
+            );
+        }
         s += &format!(
             "time: enumerate {:.2} s, compile {:.2} s, optimize {:.2} s, check {:.2} s (CPU seconds over all workers), export {:.2} s; total {:.2} s wall\n",
             t.enumerate_s, t.compile_s, t.optimize_s, t.check_s, t.export_s, t.total_s

@@ -2,13 +2,13 @@
 
 use super::output::{self, OutputDir, RECORDS, RunSettings, SETTINGS};
 use super::progress::Progress;
-use super::record::{AlternativeRecord, Summary, Timings, level_distribution};
+use super::record::{AlternativeRecord, CyclicCounts, Summary, Timings, level_distribution};
 use super::report::{report_design, report_input, task_facts};
 use crate::check::verify::{Tolerances, verify};
 use crate::check::{CheckError, Cylinder, MotionSettings, check_frames, two_armed};
 use crate::compile::Options as CompileOptions;
 use crate::export::{self, DesignMeta, ExportOptions};
-use crate::grammar::{CreaseGraph, Enumeration, Filters};
+use crate::grammar::{CreaseGraph, Enumeration, Filters, Rules};
 use crate::limits;
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
@@ -52,6 +52,8 @@ pub struct SearchOptions {
     /// Show progress on stderr: a bar on a terminal, a status line every few seconds
     /// otherwise (see [`Progress`]).
     pub progress: bool,
+    /// The grammar's rules (default r1, r2; r2′ adds cyclic patterns).
+    pub rules: Rules,
 }
 
 impl Default for SearchOptions {
@@ -67,6 +69,7 @@ impl Default for SearchOptions {
             sweep: 181,
             export: true,
             progress: true,
+            rules: Rules::default(),
         }
     }
 }
@@ -221,14 +224,21 @@ fn evaluate(
     let key = alt.key();
     let t0 = Instant::now();
     let problem = ModelProblem::new(model, &p.compiled, &modes);
-    let sol = minimize(
+    let optimize_opts = optimize::Options {
+        starts: opts.starts,
+        seed: alternative_seed(opts.seed, &key),
+        target: Some(objective_target(model)),
+        ..Default::default()
+    };
+    let mut sol = minimize(&problem, &optimize_opts);
+    // Cyclic patterns: Newton on the compatibility equations, to rounding.
+    crate::model::cycle::polish_solution(
         &problem,
-        &optimize::Options {
-            starts: opts.starts,
-            seed: alternative_seed(opts.seed, &key),
-            target: Some(objective_target(model)),
-            ..Default::default()
-        },
+        model,
+        &modes,
+        &mut sol,
+        optimize_opts.feasibility_tol,
+        optimize_opts.target,
     );
     let optimize_ms = t0.elapsed().as_secs_f64() * 1e3;
     let full = model.full_vars(&sol.x);
@@ -266,6 +276,7 @@ fn evaluate(
         evaluations: sol.evaluations,
         optimize_ms,
         check_ms: 0.0,
+        cycle: None,
     };
     if !meets {
         return rec;
@@ -313,7 +324,7 @@ fn evaluate(
     let tol = Tolerances::default();
     let report = verify(&design, &sample_times(model.t_max, opts.sweep), &tol);
     let failed = !report.geometry_passes(&tol);
-    if failed {
+    if failed && model.plan.sinks.is_empty() {
         eprintln!(
             "BUG: verification failed for {} (graph {}): {}",
             rec.key,
@@ -321,7 +332,22 @@ fn evaluate(
             report.failures(&tol).join("; ")
         );
     }
-    rec.verification_failed = Some(failed);
+    if !model.plan.sinks.is_empty() {
+        // A cyclic design (r2′): the PTU's frames are only right where the cycle closes, so
+        // the sweep and the simulation decide; a geometric failure is a bug only then.
+        let verdict = crate::simulate::crossval::verify_cyclic(
+            model,
+            &design.vars,
+            &design.modes,
+            opts.sweep,
+            tol.geometry_margin,
+        );
+        let failed = failed && verdict.sweep.passes(crate::check::cycle::CYCLE_TOL);
+        rec.verification_failed = Some(failed);
+        rec.cycle = Some(verdict);
+    } else {
+        rec.verification_failed = Some(failed);
+    }
     rec.verification = Some(report);
     rec.check_ms = t1.elapsed().as_secs_f64() * 1e3;
     rec
@@ -362,8 +388,9 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     let progress = Progress::new(opts.progress);
     progress.phase("enumerate graphs", "graphs", None);
     let t0 = Instant::now();
-    let enumeration = Enumeration::run_within(task, n_max, Filters::all(), limits::GRAPHS_MAX)
-        .map_err(|est| terr(&est.refusal(&task.name, n_max, Filters::all())))?;
+    let enumeration =
+        Enumeration::run_within_with(task, n_max, Filters::all(), opts.rules, limits::GRAPHS_MAX)
+            .map_err(|est| terr(&est.refusal(&task.name, n_max, Filters::all())))?;
     let graphs: Vec<&CreaseGraph> = enumeration.meaningful().map(|n| &n.graph).collect();
     let enumerate_s = t0.elapsed().as_secs_f64();
     progress.inc(graphs.len() as u64);
@@ -412,6 +439,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         seed: opts.seed,
         sweep: opts.sweep,
         foldsynth: env!("CARGO_PKG_VERSION").into(),
+        rules: (opts.rules != Rules::default()).then(|| opts.rules.names()),
     };
     let opened = OutputDir::open(&opts.out, &settings, opts.resume, opts.force)?;
     for note in &opened.notes {
@@ -599,6 +627,12 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
             "sweep": opts.sweep, "resumed": finished.len(), "resume": resume,
         }),
         designs: feasible.iter().map(|r| r.id()).collect(),
+        cyclic: opts.rules.r2p.then(|| {
+            CyclicCounts::count(
+                graphs.iter().filter(|g| g.is_cyclic_pattern()).count(),
+                &records,
+            )
+        }),
     };
 
     let t2 = Instant::now();
@@ -625,15 +659,21 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
 
 /// The export metadata of a design.
 fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMeta {
+    let mut meta = model_meta(task, model, &rec.modes, rec.objective);
+    meta.extra
+        .insert("candidate".to_string(), json!(rec.candidate));
+    meta.extra.insert("key".to_string(), json!(rec.key));
+    meta
+}
+
+/// The export metadata of a design of `model` with `modes` ("up"/"down") and objective
+/// Ω* (also for designs outside a search, e.g. `foldsynth model --save`).
+pub fn model_meta(task: &Task, model: &Model, modes: &[String], objective: f64) -> DesignMeta {
     let multi = model.targets.len() > 1;
-    let mut extra = BTreeMap::new();
-    extra.insert("candidate".to_string(), json!(rec.candidate));
-    extra.insert("key".to_string(), json!(rec.key));
     DesignMeta {
         task: task.name.clone(),
-        rule_sequence: rec.sequence.clone(),
-        modes: rec
-            .modes
+        rule_sequence: model.plan.sequence.clone(),
+        modes: modes
             .iter()
             .map(|m| {
                 if m == "up" {
@@ -645,7 +685,7 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
             .collect(),
         // The vertex name (1-based), as in the rule sequence and the record.
         gripping_vertex: Some(model.plan.vertices[model.gripping].name),
-        objective: Some(rec.objective),
+        objective: Some(objective),
         targets: model
             .targets
             .iter()
@@ -664,7 +704,7 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
             .as_ref()
             .and_then(|c| c.cylinders.first().copied()),
         second_arm: task.check.as_ref().is_some_and(|c| c.second_arm),
-        extra,
+        extra: BTreeMap::new(),
     }
 }
 
