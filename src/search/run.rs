@@ -694,6 +694,7 @@ fn write_designs(
                 "obstacle_free": rec.obstacle_free,
                 "pattern": pattern,
                 "meta": meta,
+                "svg": export::svg::svg_scale(&pattern, &Default::default()).ok(),
             });
             let path = dir.join(format!("{id}.json"));
             fs::write(
