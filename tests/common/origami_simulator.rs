@@ -65,7 +65,7 @@ pub fn import_svg(text: &str, tol: f64) -> Imported {
         .collect();
     let mut raw: Vec<[f64; 2]> = Vec::new();
     // Segments per type: (first vertex, target angle if any).
-    let mut by_type: HashMap<char, Vec<([usize; 2], Option<f64>)>> = HashMap::new();
+    let mut by_type: HashMap<char, Vec<Segment>> = HashMap::new();
     for ty in ['B', 'M', 'V', 'C', 'F', 'U'] {
         for l in &lines {
             let Some(stroke) = l.attribute("stroke") else {
@@ -118,6 +118,9 @@ pub fn import_svg(text: &str, tol: f64) -> Imported {
     }
     import(f, tol)
 }
+
+/// A line's two raw vertices and its target angle, if any.
+type Segment = ([usize; 2], Option<f64>);
 
 fn type_for_stroke(stroke: &str) -> Option<char> {
     let s: String = stroke
@@ -365,7 +368,7 @@ fn remove_stray_vertices(f: &mut Imported, nbrs: &mut Vec<Vec<usize>>) {
 }
 
 /// `removeRedundantVertices` with its `mergeEdge`.
-fn remove_redundant_vertices(f: &mut Imported, nbrs: &mut Vec<Vec<usize>>, eps: f64) {
+fn remove_redundant_vertices(f: &mut Imported, nbrs: &mut [Vec<usize>], eps: f64) {
     let mut old2new = Vec::with_capacity(nbrs.len());
     let mut next = 0;
     let mut merged_any = false;
