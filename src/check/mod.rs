@@ -4,6 +4,8 @@
 //! * [`tri_tri`] — Möller's triangle–triangle test with a contact tolerance;
 //! * [`self_intersection`] — facet pairs at one state: crossings and the flip test of
 //!   thesis Sec. 3.2.4;
+//! * [`features`] — feature size of the flat layout (vertex–vertex, vertex–edge, edge
+//!   lengths): what fabrication and importers that snap geometry need;
 //! * [`cylinder`] — the finite-cylinder obstacle of the gripper task (Sec. 5.5);
 //! * [`motion`] — the flat layout and evenly spaced states of a motion (16 in the thesis);
 //! * [`rotated_copy`] — the two-armed gripper built from one arm;
@@ -28,6 +30,7 @@
 
 pub mod cycle;
 pub mod cylinder;
+pub mod features;
 pub mod motion;
 pub mod rotated_copy;
 pub mod self_intersection;

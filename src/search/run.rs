@@ -791,6 +791,7 @@ fn write_designs(
                 "obstacle_free": rec.obstacle_free,
                 "pattern": pattern,
                 "meta": meta,
+                "svg": export::svg::svg_scale(&pattern, &Default::default()).ok(),
             });
             let path = out_dir.write(
                 &format!("designs/{id}.json"),
