@@ -36,6 +36,7 @@ fn build_report(out: &Path) -> PathBuf {
             meta: m,
             files,
             verify,
+            margins: vec![("rigid margin".into(), "0.1 rad".into())],
         });
     }
     let tree = vec![

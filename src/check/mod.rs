@@ -6,7 +6,9 @@
 //!   thesis Sec. 3.2.4;
 //! * [`cylinder`] — the finite-cylinder obstacle of the gripper task (Sec. 5.5);
 //! * [`motion`] — the flat layout and evenly spaced states of a motion (16 in the thesis);
-//! * [`rotated_copy`] — the two-armed gripper built from one arm.
+//! * [`rotated_copy`] — the two-armed gripper built from one arm;
+//! * [`robustness`] — margins of a motion (rigid margin, clearances) measured exactly,
+//!   independently of the optimizer's clearance constraints.
 //!
 //! ```
 //! use foldsynth::check::{Checker, MotionSettings, check_motion};
@@ -27,6 +29,7 @@
 
 pub mod cylinder;
 pub mod motion;
+pub mod robustness;
 pub mod rotated_copy;
 pub mod self_intersection;
 pub mod tri_tri;

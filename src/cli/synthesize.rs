@@ -38,6 +38,10 @@ pub struct SynthesizeArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
+    /// Today's behaviour before issue 12: optimize without the clearance and margin
+    /// constraints, judge only afterwards (to compare the two on the same alternatives).
+    #[arg(long)]
+    pub post_check_only: bool,
 }
 
 /// Run `foldsynth synthesize`.
@@ -62,6 +66,7 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         sweep: args.sweep.max(2),
         export: !args.no_export,
         progress: true,
+        post_check_only: args.post_check_only,
     };
     let summary = search::run(&task, &opts)?;
     if args.json {

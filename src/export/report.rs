@@ -60,6 +60,8 @@ pub struct ReportDesign {
     pub files: Files,
     /// The result of verifying its FOLD file, if run.
     pub verify: Option<VerifyReport>,
+    /// Its robustness margins as (label, text) rows; cards come most robust first.
+    pub margins: Vec<(String, String)>,
 }
 
 /// Everything the report shows.
@@ -174,6 +176,9 @@ fn design_card(out_dir: &Path, d: &ReportDesign) -> Result<String> {
     );
     for (k, v) in &m.extra {
         row(k, v.to_string());
+    }
+    for (k, v) in &d.margins {
+        row(k, v.clone());
     }
     s += "</tbody></table>\n";
     if let Some(v) = &d.verify {

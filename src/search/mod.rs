@@ -12,5 +12,5 @@
 mod record;
 mod run;
 
-pub use record::{AlternativeRecord, Summary, Timings, level_distribution};
+pub use record::{AlternativeRecord, RankEntry, Summary, Timings, level_distribution};
 pub use run::{Alternative, SearchError, SearchOptions, prepare, run};

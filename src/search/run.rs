@@ -1,15 +1,17 @@
 //! Running a search: scheduling, streaming, resuming, summarizing, exporting.
 
-use super::record::{AlternativeRecord, Summary, Timings, level_distribution};
+use super::record::{AlternativeRecord, RankEntry, Summary, Timings, level_distribution};
+use crate::check::robustness::{self, RobustnessInput, UnitCreases};
 use crate::check::verify::{Tolerances, verify};
-use crate::check::{CheckError, Cylinder, MotionSettings, check_frames, two_armed};
+use crate::check::{CheckError, Checker, Cylinder, MotionSettings, check_states, two_armed};
 use crate::compile::Options as CompileOptions;
 use crate::export::{self, DesignMeta, ExportOptions};
 use crate::grammar::{CreaseGraph, Enumeration, Filters};
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
+use crate::model::robust::{RobustModel, RobustProblem, RobustSpec};
 use crate::model::{Model, ModelError};
-use crate::optimize::{self, minimize};
+use crate::optimize::{self, minimize, minimize_robust};
 use crate::pattern::Pattern;
 use crate::task::Task;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -43,6 +45,9 @@ pub struct SearchOptions {
     pub export: bool,
     /// Show a progress bar on stderr (only drawn on a terminal).
     pub progress: bool,
+    /// Today's behaviour before issue 12: optimize without the robustness block and only
+    /// check afterwards (for side-by-side comparisons).
+    pub post_check_only: bool,
 }
 
 impl Default for SearchOptions {
@@ -57,6 +62,7 @@ impl Default for SearchOptions {
             sweep: 181,
             export: true,
             progress: true,
+            post_check_only: false,
         }
     }
 }
@@ -141,17 +147,33 @@ pub struct Prepared {
     pub model: Model,
     /// Its native code.
     pub compiled: CompiledModel,
+    /// Its robustness block (absent with `--post-check-only`).
+    pub robust: Option<RobustModel>,
 }
 
 /// A lazily compiled model (or why it failed) and the seconds it took.
 type CompiledSlot = (Result<Arc<Prepared>, String>, f64);
 
-/// Build and compile the model of one graph and candidate.
-pub fn prepare(graph: &CreaseGraph, task: &Task, candidate: usize) -> Result<Prepared, String> {
+/// Build and compile the model of one graph and candidate, with its robustness block
+/// when `robust` is given.
+pub fn prepare(
+    graph: &CreaseGraph,
+    task: &Task,
+    candidate: usize,
+    robust: Option<&RobustSpec>,
+) -> Result<Prepared, String> {
     let model = Model::new(graph, task, candidate).map_err(|e| e.to_string())?;
     let compiled =
         CompiledModel::new(&model, &CompileOptions::default()).map_err(|e| e.to_string())?;
-    Ok(Prepared { model, compiled })
+    let robust = robust
+        .map(|spec| RobustModel::new(&model, spec.clone()))
+        .transpose()
+        .map_err(|e| e.to_string())?;
+    Ok(Prepared {
+        model,
+        compiled,
+        robust,
+    })
 }
 
 /// A 64-bit mix (splitmix64) of the run's seed and an alternative's key: every alternative
@@ -206,15 +228,19 @@ fn evaluate(
     let key = alt.key();
     let t0 = Instant::now();
     let problem = ModelProblem::new(model, &p.compiled, &modes);
-    let sol = minimize(
-        &problem,
-        &optimize::Options {
-            starts: opts.starts,
-            seed: alternative_seed(opts.seed, &key),
-            target: Some(objective_target(model)),
-            ..Default::default()
-        },
-    );
+    let oo = optimize::Options {
+        starts: opts.starts,
+        seed: alternative_seed(opts.seed, &key),
+        target: Some(objective_target(model)),
+        ..Default::default()
+    };
+    let sol = match &p.robust {
+        None => minimize(&problem, &oo),
+        Some(block) => {
+            let rp = RobustProblem::new(model, block, &modes);
+            minimize_robust(&problem, Some(&rp), &oo)
+        }
+    };
     let optimize_ms = t0.elapsed().as_secs_f64() * 1e3;
     let full = model.full_vars(&sol.x);
     let omega = model.omega(&full, &modes);
@@ -246,6 +272,9 @@ fn evaluate(
         obstacle_hit: None,
         verification: None,
         verification_failed: None,
+        robust_accepted: sol.robust,
+        robust_attempts: sol.robust_attempts,
+        robustness: None,
         variables,
         starts_run: sol.starts_run,
         evaluations: sol.evaluations,
@@ -257,35 +286,47 @@ fn evaluate(
     }
     let t1 = Instant::now();
     let design = Evaluated::new(&model.plan, full, modes);
-    let states = task.check.as_ref().map(|c| c.states).unwrap_or(16);
-    let arm = design.pattern(&sample_times(model.t_max, states));
+    // The judges run on the dense verification sweep, not only on the states the optimizer
+    // saw, so an intersection between sampled states cannot hide.
+    let arm = design.pattern(&sample_times(model.t_max, opts.sweep));
     let checked = checked_pattern(task, &arm)
         .map_err(CheckFailure::Other)
         .and_then(|pat| {
-            let run = |obstacles| {
-                check_frames(
-                    &pat,
-                    &MotionSettings {
-                        n_states: states,
-                        stop_at_first: true,
-                        obstacles,
-                    },
-                )
-                .map_err(|e| match e {
-                    // A facet that cannot be triangulated is inverted or overlaps itself in the
-                    // flat layout: the paper crosses itself before it folds.
-                    CheckError::Triangulate(t) => CheckFailure::Layout(t.to_string()),
-                    e => CheckFailure::Other(e.to_string()),
+            let checker = Checker::from_pattern(&pat).map_err(|e| match e {
+                // A facet that cannot be triangulated is inverted or overlaps itself in the
+                // flat layout: the paper crosses itself before it folds.
+                CheckError::Triangulate(t) => CheckFailure::Layout(t.to_string()),
+                e => CheckFailure::Other(e.to_string()),
+            })?;
+            let s = check_states(
+                &checker,
+                Some(&pat.vertices),
+                pat.frames.iter().map(|f| (f.t, f.coords.clone())),
+                &MotionSettings {
+                    n_states: opts.sweep,
+                    stop_at_first: true,
+                    obstacles: Vec::new(),
+                },
+            )
+            .map_err(|e| CheckFailure::Other(e.to_string()))?;
+            let cyl = obstacles(task);
+            let hit = pat.frames.iter().find_map(|f| {
+                cyl.iter().enumerate().find_map(|(k, c)| {
+                    checker
+                        .obstacle_hits(&f.coords, c, k, f.t, true)
+                        .first()
+                        .copied()
                 })
-            };
-            Ok((run(Vec::new())?, run(obstacles(task))?))
+            });
+            Ok((s, hit, pat))
         });
     match checked {
-        Ok((s, o)) => {
+        Ok((s, hit, pat)) => {
             rec.self_intersection_free = Some(s.self_intersection_free());
             rec.self_intersection = s.first_intersection().cloned();
-            rec.obstacle_free = Some(o.obstacle_hits.is_empty());
-            rec.obstacle_hit = o.first_obstacle_hit().cloned();
+            rec.obstacle_free = Some(hit.is_none());
+            rec.obstacle_hit = hit;
+            rec.robustness = measure_robustness(task, model, &arm, &pat);
         }
         Err(CheckFailure::Layout(why)) => {
             rec.self_intersection_free = Some(false);
@@ -310,6 +351,81 @@ fn evaluate(
     rec.verification = Some(report);
     rec.check_ms = t1.elapsed().as_secs_f64() * 1e3;
     rec
+}
+
+/// The robustness of a design measured by `check::robustness` on the checked pattern
+/// (`pat`: the arm, or both arms) at the sweep's frames.
+fn measure_robustness(
+    task: &Task,
+    model: &Model,
+    arm: &Pattern,
+    pat: &Pattern,
+) -> Option<robustness::RobustnessReport> {
+    let plan = &model.plan;
+    let face_names: Vec<String> = plan
+        .polygons
+        .iter()
+        .enumerate()
+        .filter(|(_, (p, _))| p.len() >= 3)
+        .map(|(f, _)| plan.facet_names[f].clone())
+        .collect();
+    let n = arm.vertices.len();
+    let vertex_names = (0..pat.vertices.len())
+        .map(|v| {
+            if v < n {
+                format!("v{}", plan.vertices[v].name)
+            } else {
+                format!("copy #{}", v - n + 1)
+            }
+        })
+        .collect();
+    let units = plan
+        .internal
+        .iter()
+        .map(|&a| {
+            let v = &plan.vertices[a];
+            let m = v.preds;
+            UnitCreases {
+                vertex: a,
+                ends: [0, 1, 2].map(|k| v.rays[m + k].other),
+                label: format!("v{}", v.name),
+            }
+        })
+        .collect();
+    let cylinders = obstacles(task);
+    // The arms of a two-armed gripper meet at a target on the rotation axis: their tips
+    // touch there by design (the copy of the gripping vertex is found by its flat position).
+    let tip = (pat.vertices.len() > n
+        && model
+            .targets
+            .iter()
+            .any(|t| t.point[0].abs() < 1e-9 && t.point[1].abs() < 1e-9))
+    .then(|| {
+        let g = model.gripping;
+        let q = [-arm.vertices[g][0], -arm.vertices[g][1]];
+        (n..pat.vertices.len())
+            .find(|&j| (pat.vertices[j][0] - q[0]).hypot(pat.vertices[j][1] - q[1]) <= 1e-9)
+            .map(|c| (g, c))
+    })
+    .flatten();
+    let input = RobustnessInput {
+        pattern: pat,
+        arm_faces: arm.faces.len(),
+        face_names,
+        vertex_names,
+        cylinders: &cylinders,
+        units,
+        tip,
+        t_max: model.t_max,
+        settings: task.robustness,
+    };
+    match robustness::measure(&input) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            eprintln!("warning: the robustness measurement failed: {e}");
+            None
+        }
+    }
 }
 
 /// Records already written by an earlier run (a torn last line from a kill is skipped).
@@ -381,6 +497,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     let settings = json!({
         "task": task.name, "n_max": n_max, "starts": opts.starts, "seed": opts.seed,
         "sweep": opts.sweep, "foldsynth": env!("CARGO_PKG_VERSION"),
+        "post_check_only": opts.post_check_only,
     });
     if opts.resume
         && let Ok(text) = fs::read_to_string(&settings_path)
@@ -433,6 +550,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
             .map_err(io(&jsonl))?,
     );
 
+    let robust_spec = (!opts.post_check_only).then(|| RobustSpec::from_task(task, opts.sweep));
     let cache: Vec<OnceLock<CompiledSlot>> =
         (0..graphs.len() * 3).map(|_| OnceLock::new()).collect();
     let bar = if opts.progress && std::io::stderr().is_terminal() {
@@ -458,7 +576,8 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
                 let slot = &cache[alt.graph * 3 + alt.candidate];
                 let (prepared, _) = slot.get_or_init(|| {
                     let t = Instant::now();
-                    let p = prepare(graphs[alt.graph], task, alt.candidate).map(Arc::new);
+                    let p = prepare(graphs[alt.graph], task, alt.candidate, robust_spec.as_ref())
+                        .map(Arc::new);
                     (p, t.elapsed().as_secs_f64())
                 });
                 let prepared = match prepared {
@@ -500,8 +619,10 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         export_s: 0.0,
         total_s: 0.0,
     };
-    let feasible: Vec<&AlternativeRecord> =
+    let mut feasible: Vec<&AlternativeRecord> =
         records.iter().filter(|r| r.feasible_design()).collect();
+    // Most robust first (ties: enumeration order).
+    feasible.sort_by(|a, b| b.score().total_cmp(&a.score()));
     let mut summary = Summary {
         task: task.name.clone(),
         n_max,
@@ -537,7 +658,33 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         settings: json!({
             "starts": opts.starts, "seed": opts.seed, "jobs": pool.current_num_threads(),
             "sweep": opts.sweep, "resumed": finished.len(),
+            "post_check_only": opts.post_check_only,
+            "optimize_states": robust_spec.as_ref().map(|s| s.states),
+            "robustness": {
+                "rigid_margin": task.robustness.rigid_margin,
+                "clearance": task.robustness.clearance,
+                "obstacle_clearance": task.robustness.obstacle_clearance,
+            },
         }),
+        meets_margins: feasible
+            .iter()
+            .filter(|r| r.robustness.as_ref().is_some_and(|x| x.meets_settings()))
+            .count(),
+        near_rigid_limit: feasible
+            .iter()
+            .filter(|r| {
+                r.robustness
+                    .as_ref()
+                    .is_some_and(|x| x.rigid_margin.value < 1e-3)
+            })
+            .count(),
+        ranking: feasible
+            .iter()
+            .map(|r| RankEntry {
+                id: r.id(),
+                score: r.robustness.as_ref().map(|x| x.score),
+            })
+            .collect(),
         designs: feasible.iter().map(|r| r.id()).collect(),
     };
 
@@ -616,8 +763,8 @@ fn write_designs(
     }
     fs::create_dir_all(&dir).map_err(io(&dir))?;
     // Designs are independent: write them in parallel, keep the cards in order.
-    let write_one =
-        |rec: &&AlternativeRecord| -> Result<Option<export::report::ReportDesign>, SearchError> {
+    let write_one = |(rank, rec): (usize, &&AlternativeRecord)| -> Result<Option<export::report::ReportDesign>, SearchError> {
+            let rank = rank + 1;
             let model = Model::new(graphs[rec.graph], task, rec.candidate - 1)?;
             let free: Vec<f64> = model
                 .free
@@ -670,6 +817,8 @@ fn write_designs(
                 "verification": rec.verification,
                 "self_intersection_free": rec.self_intersection_free,
                 "obstacle_free": rec.obstacle_free,
+                "robustness": rec.robustness,
+                "rank": rank,
                 "pattern": pattern,
                 "meta": meta,
             });
@@ -704,6 +853,11 @@ fn write_designs(
                 meta,
                 files,
                 verify: Some(check),
+                margins: rec
+                    .robustness
+                    .as_ref()
+                    .map(margin_rows)
+                    .unwrap_or_default(),
             }))
         };
     let pool = rayon::ThreadPoolBuilder::new()
@@ -714,6 +868,7 @@ fn write_designs(
         .install(|| {
             feasible
                 .par_iter()
+                .enumerate()
                 .map(write_one)
                 .collect::<Result<Vec<_>, _>>()
         })?
@@ -726,6 +881,34 @@ fn write_designs(
             .map_err(|e| SearchError::Export(e.to_string()))?;
     }
     Ok(())
+}
+
+/// The margins of a design as report rows (label, text).
+fn margin_rows(r: &robustness::RobustnessReport) -> Vec<(String, String)> {
+    let mut rows = vec![("robustness score".to_string(), format!("{:.3}", r.score))];
+    let mut row = |label: &str, m: &robustness::MarginReport, unit: &str| {
+        rows.push((
+            label.to_string(),
+            format!(
+                "{:.4}{unit} (setting {:.4}{unit}) at {}, t = {}",
+                m.value,
+                m.setting,
+                m.location,
+                m.t.map_or("–".into(), |t| format!("{t:.3}"))
+            ),
+        ));
+    };
+    row("rigid margin", &r.rigid_margin, " rad");
+    for (label, m) in [
+        ("self clearance", &r.self_clearance),
+        ("arm clearance", &r.arm_clearance),
+        ("obstacle clearance", &r.obstacle_clearance),
+    ] {
+        if let Some(m) = m {
+            row(label, m, "");
+        }
+    }
+    rows
 }
 
 /// The report's content.
