@@ -10,6 +10,7 @@
 pub mod clearance;
 pub mod compiled;
 pub mod geometry;
+pub mod interface;
 pub mod linalg;
 pub mod numeric;
 pub mod plan;

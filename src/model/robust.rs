@@ -798,7 +798,7 @@ impl Robust for RobustProblem<'_> {
                 buffers,
             );
             let mut h_min = f64::INFINITY;
-            b.visit(t, values, &planes, Level::Accept, |slot, _, h, _| {
+            b.visit(t, values, &planes, Level::Accept, |_, _, h, _| {
                 h_min = h_min.min(h);
             });
             if h_min < -1e-12 {
