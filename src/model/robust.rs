@@ -570,13 +570,26 @@ impl<'a> RobustProblem<'a> {
     }
 
     /// Set every multiplier to `lambda` (to examine the merit where every term is smooth:
-    /// with `λ > μ h` for all constraints, no `max(0, ·)` switches).
+    /// with `λ > μ h` for all constraints, no `max(0, ·)` switches). The flat state t = 0
+    /// leaves the merit: its fold angles are 0, where `|ρ|` switches, and its vertex
+    /// triangles are degenerate.
     pub fn set_multipliers(&self, lambda: f64) {
         for st in self.states.borrow_mut().iter_mut() {
             st.lambda.iter_mut().for_each(|l| *l = lambda);
             st.active.iter_mut().for_each(|a| *a = true);
-            st.live = true;
+            st.live = st.t > 0.0;
         }
+    }
+
+    /// The planes that are variables of the current subproblem (after
+    /// [`Robust::variables`]): the state's t and the pair, in the order of the variables.
+    pub fn variable_planes(&self) -> Vec<(f64, Pair)> {
+        let states = self.states.borrow();
+        self.layout
+            .borrow()
+            .iter()
+            .map(|&(si, p, _)| (states[si].t, self.block.pairs.pairs[p].clone()))
+            .collect()
     }
 
     /// The t of every sampled state (the evenly spaced ones, then those added).

@@ -16,4 +16,4 @@ mod run;
 
 pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
 pub use record::{AlternativeRecord, RankEntry, Summary, Timings, level_distribution};
-pub use run::{Alternative, SearchError, SearchOptions, prepare, run};
+pub use run::{Alternative, SearchError, SearchOptions, prepare, remeasure, run};

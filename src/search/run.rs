@@ -329,7 +329,16 @@ fn evaluate(
             rec.self_intersection = s.first_intersection().cloned();
             rec.obstacle_free = Some(hit.is_none());
             rec.obstacle_hit = hit;
-            rec.robustness = measure_robustness(task, model, &arm, &pat);
+            rec.robustness = match measure_robustness(task, model, &arm, &pat) {
+                Ok(r) => Some(r),
+                Err(e) => {
+                    eprintln!(
+                        "warning: {}: the robustness measurement failed: {e}",
+                        rec.key
+                    );
+                    None
+                }
+            };
         }
         Err(CheckFailure::Layout(why)) => {
             rec.self_intersection_free = Some(false);
@@ -363,7 +372,7 @@ fn measure_robustness(
     model: &Model,
     arm: &Pattern,
     pat: &Pattern,
-) -> Option<robustness::RobustnessReport> {
+) -> Result<robustness::RobustnessReport, String> {
     let plan = &model.plan;
     let face_names: Vec<String> = plan
         .polygons
@@ -422,13 +431,53 @@ fn measure_robustness(
         t_max: model.t_max,
         settings: task.robustness,
     };
-    match robustness::measure(&input) {
-        Ok(r) => Some(r),
-        Err(e) => {
-            eprintln!("warning: the robustness measurement failed: {e}");
-            None
-        }
-    }
+    robustness::measure(&input).map_err(|e| e.to_string())
+}
+
+/// The model of a record's graph and candidate, and the record's free variables, all
+/// variables and mode signs.
+type Design = (Model, Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// Rebuild a recorded design ([`Design`]).
+fn design_of(
+    task: &Task,
+    graph: &CreaseGraph,
+    rec: &AlternativeRecord,
+) -> Result<Design, SearchError> {
+    let model = Model::new(graph, task, rec.candidate - 1)?;
+    let free: Vec<f64> = model
+        .free
+        .iter()
+        .map(|&i| {
+            rec.variables
+                .get(&model.plan.variables[i].name)
+                .copied()
+                .unwrap_or(model.var_bounds(i).0)
+        })
+        .collect();
+    let full = model.full_vars(&free);
+    let modes: Vec<f64> = rec
+        .modes
+        .iter()
+        .map(|m| if m == "up" { 1.0 } else { -1.0 })
+        .collect();
+    Ok((model, free, full, modes))
+}
+
+/// The robustness of a recorded design measured again by `check::robustness` on a sweep of
+/// `states` states (e.g. denser than the search's): `graph` is the record's graph (the
+/// enumeration's meaningful graphs, in order, indexed by `rec.graph`).
+pub fn remeasure(
+    task: &Task,
+    graph: &CreaseGraph,
+    rec: &AlternativeRecord,
+    states: usize,
+) -> Result<robustness::RobustnessReport, String> {
+    let (model, _, full, modes) = design_of(task, graph, rec).map_err(|e| e.to_string())?;
+    let design = Evaluated::new(&model.plan, full, modes);
+    let arm = design.pattern(&sample_times(model.t_max, states.max(2)));
+    let pat = checked_pattern(task, &arm)?;
+    measure_robustness(task, &model, &arm, &pat)
 }
 
 /// Records already written by an earlier run (a torn last line from a kill is skipped).
@@ -787,23 +836,7 @@ fn write_designs(
     );
     let write_one = |(rank, rec): (usize, &&AlternativeRecord)| -> Result<export::report::ReportDesign, SearchError> {
             let rank = rank + 1;
-            let model = Model::new(graphs[rec.graph], task, rec.candidate - 1)?;
-            let free: Vec<f64> = model
-                .free
-                .iter()
-                .map(|&i| {
-                    rec.variables
-                        .get(&model.plan.variables[i].name)
-                        .copied()
-                        .unwrap_or(model.var_bounds(i).0)
-                })
-                .collect();
-            let full = model.full_vars(&free);
-            let modes: Vec<f64> = rec
-                .modes
-                .iter()
-                .map(|m| if m == "up" { 1.0 } else { -1.0 })
-                .collect();
+            let (model, free, full, modes) = design_of(task, graphs[rec.graph], rec)?;
             let design = Evaluated::new(&model.plan, full.clone(), modes);
             let pattern = design.pattern(&sample_times(model.t_max, 33));
             let meta = design_meta(task, &model, rec);
