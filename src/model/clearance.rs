@@ -616,7 +616,7 @@ fn min_norm_point(support: impl Fn(V3) -> V3, start: V3, iters: usize, tol: f64)
     z
 }
 
-fn argmin_dot<'a>(pts: &'a [V3], d: V3) -> &'a V3 {
+fn argmin_dot(pts: &[V3], d: V3) -> &V3 {
     let mut best = &pts[0];
     let mut v = dot(d, *best);
     for p in &pts[1..] {
