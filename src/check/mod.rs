@@ -10,6 +10,8 @@
 //! * [`motion`] — the flat layout and evenly spaced states of a motion (16 in the thesis);
 //! * [`rotated_copy`] — the two-armed gripper built from one arm;
 //! * [`cycle`] — cyclic designs (r2′): compatibility and position agreement over a sweep.
+//! * [`robustness`] — margins of a motion (rigid margin, clearances) measured exactly,
+//!   independently of the optimizer's clearance constraints.
 //!
 //! ```
 //! use foldsynth::check::{Checker, MotionSettings, check_motion};
@@ -32,6 +34,7 @@ pub mod cycle;
 pub mod cylinder;
 pub mod features;
 pub mod motion;
+pub mod robustness;
 pub mod rotated_copy;
 pub mod self_intersection;
 pub mod tri_tri;

@@ -51,6 +51,10 @@ pub struct SynthesizeArgs {
     /// overconstrained patterns such as the Miura-ori, verified by simulation).
     #[arg(long, default_value = "r1,r2", value_name = "RULES")]
     pub rules: crate::grammar::Rules,
+    /// Today's behaviour before issue 12: optimize without the clearance and margin
+    /// constraints, judge only afterwards (to compare the two on the same alternatives).
+    #[arg(long)]
+    pub post_check_only: bool,
 }
 
 /// Run `foldsynth synthesize`.
@@ -69,6 +73,7 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         export: !args.no_export,
         progress: true,
         rules: args.rules,
+        post_check_only: args.post_check_only,
     };
     let summary = search::run(&task, &opts)?;
     let files = format!(

@@ -7,6 +7,7 @@
 //! constraints ψ, and the choice of gripping vertex. The same code runs in `f64` (the
 //! numeric path that verification and export read) and on symbols (the compiled model).
 
+pub mod clearance;
 pub mod compiled;
 pub mod cycle;
 pub mod geometry;
@@ -14,6 +15,7 @@ pub mod interface;
 pub mod linalg;
 pub mod numeric;
 pub mod plan;
+pub mod robust;
 
 pub use plan::{Constraint, Plan, PlanError};
 

@@ -18,5 +18,7 @@ mod report;
 mod run;
 
 pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
-pub use record::{AlternativeRecord, Summary, Timings, level_distribution};
-pub use run::{Alternative, SearchError, SearchOptions, model_meta, prepare, run};
+pub use record::{AlternativeRecord, RankEntry, Summary, Timings, level_distribution};
+pub use run::{
+    Alternative, SearchError, SearchOptions, model_meta, prepare, remeasure, run,
+};

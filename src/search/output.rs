@@ -54,6 +54,8 @@ pub struct RunSettings {
     /// Grammar rules when not the default `r1,r2` (e.g. `r1,r2,r2p`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rules: Option<String>,
+    /// Optimized without the clearance and margin constraints (`--post-check-only`).
+    pub post_check_only: bool,
 }
 
 impl RunSettings {

@@ -1,5 +1,6 @@
 //! What the search writes: one record per alternative, and the summary.
 
+use crate::check::robustness::RobustnessReport;
 use crate::check::verify::VerifyReport;
 use crate::check::{Intersection, ObstacleHit};
 use serde::{Deserialize, Serialize};
@@ -50,6 +51,17 @@ pub struct AlternativeRecord {
     /// Whether verification found a bug (isometry, closure, developability or fold angles
     /// off on a rigid state).
     pub verification_failed: Option<bool>,
+    /// Whether the optimizer's robustness block accepted the result (absent with
+    /// `--post-check-only`).
+    #[serde(default)]
+    pub robust_accepted: Option<bool>,
+    /// Starts on which the optimizer ran its robustness phase.
+    #[serde(default)]
+    pub robust_attempts: usize,
+    /// Margins measured independently on the verification sweep (`check::robustness`),
+    /// for alternatives that meet the target.
+    #[serde(default)]
+    pub robustness: Option<RobustnessReport>,
     /// Free variables at the optimum by name.
     pub variables: BTreeMap<String, f64>,
     /// Starting points run.
@@ -90,6 +102,13 @@ impl AlternativeRecord {
     /// Whether the design comes from a cyclic graph (an r2′ step in its sequence).
     pub fn is_cyclic(&self) -> bool {
         self.sequence.contains(")'")
+    }
+
+    /// The robustness score (−∞ when not measured), for ranking.
+    pub fn score(&self) -> f64 {
+        self.robustness
+            .as_ref()
+            .map_or(f64::NEG_INFINITY, |r| r.score)
     }
 
     /// A file-name-safe identifier.
@@ -156,6 +175,15 @@ pub fn level_distribution(records: &[AlternativeRecord]) -> Vec<LevelCounts> {
         .collect()
 }
 
+/// One design in the ranking of `summary.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RankEntry {
+    /// The design's id.
+    pub id: String,
+    /// Its robustness score.
+    pub score: Option<f64>,
+}
+
 /// The summary of a search (`OUT/summary.json`).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Summary {
@@ -180,6 +208,15 @@ pub struct Summary {
     pub rigid_at_tmax_only: usize,
     /// Verification failures (bugs), which must be 0.
     pub verification_failures: usize,
+    /// Feasible designs whose margins, measured on the sweep, meet the task's settings.
+    #[serde(default)]
+    pub meets_margins: usize,
+    /// Feasible designs with a vertex within 1e-3 rad of its rigid limit.
+    #[serde(default)]
+    pub near_rigid_limit: usize,
+    /// The feasible designs, most robust first.
+    #[serde(default)]
+    pub ranking: Vec<RankEntry>,
     /// The thesis's figures for this task, when known (alternatives, meets target, no
     /// self-intersection, no intersection).
     pub thesis: Option<[usize; 4]>,
@@ -299,6 +336,10 @@ impl Summary {
         s += &format!(
             "  meet the target, rigid at t_max but not over the whole motion: {}\n",
             self.rigid_at_tmax_only
+        );
+        s += &format!(
+            "  … feasible designs meeting the robustness margins: {} (within 1e-3 rad of a rigid limit: {})\n",
+            self.meets_margins, self.near_rigid_limit
         );
         s += &format!(
             "  verification failures (bugs): {}\n",

@@ -2,18 +2,22 @@
 
 use super::output::{self, OutputDir, RECORDS, RunSettings, SETTINGS};
 use super::progress::Progress;
-use super::record::{AlternativeRecord, CyclicCounts, Summary, Timings, level_distribution};
+use super::record::{
+    AlternativeRecord, CyclicCounts, RankEntry, Summary, Timings, level_distribution,
+};
 use super::report::{report_design, report_input, task_facts};
+use crate::check::robustness::{self, RobustnessInput, UnitCreases};
 use crate::check::verify::{Tolerances, verify};
-use crate::check::{CheckError, Cylinder, MotionSettings, check_frames, two_armed};
+use crate::check::{CheckError, Checker, Cylinder, MotionSettings, check_states, two_armed};
 use crate::compile::Options as CompileOptions;
 use crate::export::{self, DesignMeta, ExportOptions};
 use crate::grammar::{CreaseGraph, Enumeration, Filters, Rules};
 use crate::limits;
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
+use crate::model::robust::{RobustModel, RobustProblem, RobustSpec};
 use crate::model::{Model, ModelError};
-use crate::optimize::{self, minimize};
+use crate::optimize::{self, minimize, minimize_robust};
 use crate::pattern::Pattern;
 use crate::task::Task;
 use rayon::prelude::*;
@@ -54,6 +58,9 @@ pub struct SearchOptions {
     pub progress: bool,
     /// The grammar's rules (default r1, r2; r2′ adds cyclic patterns).
     pub rules: Rules,
+    /// Today's behaviour before issue 12: optimize without the robustness block and only
+    /// check afterwards (for side-by-side comparisons).
+    pub post_check_only: bool,
 }
 
 impl Default for SearchOptions {
@@ -70,6 +77,7 @@ impl Default for SearchOptions {
             export: true,
             progress: true,
             rules: Rules::default(),
+            post_check_only: false,
         }
     }
 }
@@ -150,6 +158,8 @@ pub struct Prepared {
     pub model: Model,
     /// Its native code.
     pub compiled: CompiledModel,
+    /// Its robustness block (absent with `--post-check-only`).
+    pub robust: Option<RobustModel>,
 }
 
 /// The compiled model of one (graph, candidate) while its alternatives are evaluated.
@@ -164,12 +174,26 @@ struct Slot {
     reported: bool,
 }
 
-/// Build and compile the model of one graph and candidate.
-pub fn prepare(graph: &CreaseGraph, task: &Task, candidate: usize) -> Result<Prepared, String> {
+/// Build and compile the model of one graph and candidate, with its robustness block
+/// when `robust` is given.
+pub fn prepare(
+    graph: &CreaseGraph,
+    task: &Task,
+    candidate: usize,
+    robust: Option<&RobustSpec>,
+) -> Result<Prepared, String> {
     let model = Model::new(graph, task, candidate).map_err(|e| e.to_string())?;
     let compiled =
         CompiledModel::new(&model, &CompileOptions::default()).map_err(|e| e.to_string())?;
-    Ok(Prepared { model, compiled })
+    let robust = robust
+        .map(|spec| RobustModel::new(&model, spec.clone()))
+        .transpose()
+        .map_err(|e| e.to_string())?;
+    Ok(Prepared {
+        model,
+        compiled,
+        robust,
+    })
 }
 
 /// A 64-bit mix (splitmix64) of the run's seed and an alternative's key: every alternative
@@ -230,7 +254,13 @@ fn evaluate(
         target: Some(objective_target(model)),
         ..Default::default()
     };
-    let mut sol = minimize(&problem, &optimize_opts);
+    let mut sol = match &p.robust {
+        None => minimize(&problem, &optimize_opts),
+        Some(block) => {
+            let rp = RobustProblem::new(model, block, &modes);
+            minimize_robust(&problem, Some(&rp), &optimize_opts)
+        }
+    };
     // Cyclic patterns: Newton on the compatibility equations, to rounding.
     crate::model::cycle::polish_solution(
         &problem,
@@ -271,6 +301,9 @@ fn evaluate(
         obstacle_hit: None,
         verification: None,
         verification_failed: None,
+        robust_accepted: sol.robust,
+        robust_attempts: sol.robust_attempts,
+        robustness: None,
         variables,
         starts_run: sol.starts_run,
         evaluations: sol.evaluations,
@@ -283,35 +316,56 @@ fn evaluate(
     }
     let t1 = Instant::now();
     let design = Evaluated::new(&model.plan, full, modes);
-    let states = task.check.as_ref().map(|c| c.states).unwrap_or(16);
-    let arm = design.pattern(&sample_times(model.t_max, states));
+    // The judges run on the dense verification sweep, not only on the states the optimizer
+    // saw, so an intersection between sampled states cannot hide.
+    let arm = design.pattern(&sample_times(model.t_max, opts.sweep));
     let checked = checked_pattern(task, &arm)
         .map_err(CheckFailure::Other)
         .and_then(|pat| {
-            let run = |obstacles| {
-                check_frames(
-                    &pat,
-                    &MotionSettings {
-                        n_states: states,
-                        stop_at_first: true,
-                        obstacles,
-                    },
-                )
-                .map_err(|e| match e {
-                    // A facet that cannot be triangulated is inverted or overlaps itself in the
-                    // flat layout: the paper crosses itself before it folds.
-                    CheckError::Triangulate(t) => CheckFailure::Layout(t.to_string()),
-                    e => CheckFailure::Other(e.to_string()),
+            let checker = Checker::from_pattern(&pat).map_err(|e| match e {
+                // A facet that cannot be triangulated is inverted or overlaps itself in the
+                // flat layout: the paper crosses itself before it folds.
+                CheckError::Triangulate(t) => CheckFailure::Layout(t.to_string()),
+                e => CheckFailure::Other(e.to_string()),
+            })?;
+            let s = check_states(
+                &checker,
+                Some(&pat.vertices),
+                pat.frames.iter().map(|f| (f.t, f.coords.clone())),
+                &MotionSettings {
+                    n_states: opts.sweep,
+                    stop_at_first: true,
+                    obstacles: Vec::new(),
+                },
+            )
+            .map_err(|e| CheckFailure::Other(e.to_string()))?;
+            let cyl = obstacles(task);
+            let hit = pat.frames.iter().find_map(|f| {
+                cyl.iter().enumerate().find_map(|(k, c)| {
+                    checker
+                        .obstacle_hits(&f.coords, c, k, f.t, true)
+                        .first()
+                        .copied()
                 })
-            };
-            Ok((run(Vec::new())?, run(obstacles(task))?))
+            });
+            Ok((s, hit, pat))
         });
     match checked {
-        Ok((s, o)) => {
+        Ok((s, hit, pat)) => {
             rec.self_intersection_free = Some(s.self_intersection_free());
             rec.self_intersection = s.first_intersection().cloned();
-            rec.obstacle_free = Some(o.obstacle_hits.is_empty());
-            rec.obstacle_hit = o.first_obstacle_hit().cloned();
+            rec.obstacle_free = Some(hit.is_none());
+            rec.obstacle_hit = hit;
+            rec.robustness = match measure_robustness(task, model, &arm, &pat) {
+                Ok(r) => Some(r),
+                Err(e) => {
+                    eprintln!(
+                        "warning: {}: the robustness measurement failed: {e}",
+                        rec.key
+                    );
+                    None
+                }
+            };
         }
         Err(CheckFailure::Layout(why)) => {
             rec.self_intersection_free = Some(false);
@@ -351,6 +405,121 @@ fn evaluate(
     rec.verification = Some(report);
     rec.check_ms = t1.elapsed().as_secs_f64() * 1e3;
     rec
+}
+
+/// The robustness of a design measured by `check::robustness` on the checked pattern
+/// (`pat`: the arm, or both arms) at the sweep's frames.
+fn measure_robustness(
+    task: &Task,
+    model: &Model,
+    arm: &Pattern,
+    pat: &Pattern,
+) -> Result<robustness::RobustnessReport, String> {
+    let plan = &model.plan;
+    let face_names: Vec<String> = plan
+        .polygons
+        .iter()
+        .enumerate()
+        .filter(|(_, (p, _))| p.len() >= 3)
+        .map(|(f, _)| plan.facet_names[f].clone())
+        .collect();
+    let n = arm.vertices.len();
+    let vertex_names = (0..pat.vertices.len())
+        .map(|v| {
+            if v < n {
+                format!("v{}", plan.vertices[v].name)
+            } else {
+                format!("copy #{}", v - n + 1)
+            }
+        })
+        .collect();
+    let units = plan
+        .internal
+        .iter()
+        .map(|&a| {
+            let v = &plan.vertices[a];
+            let m = v.preds;
+            UnitCreases {
+                vertex: a,
+                ends: [0, 1, 2].map(|k| v.rays[m + k].other),
+                label: format!("v{}", v.name),
+            }
+        })
+        .collect();
+    let cylinders = obstacles(task);
+    // The arms of a two-armed gripper meet at a target on the rotation axis: their tips
+    // touch there by design (the copy of the gripping vertex is found by its flat position).
+    let tip = (pat.vertices.len() > n
+        && model
+            .targets
+            .iter()
+            .any(|t| t.point[0].abs() < 1e-9 && t.point[1].abs() < 1e-9))
+    .then(|| {
+        let g = model.gripping;
+        let q = [-arm.vertices[g][0], -arm.vertices[g][1]];
+        (n..pat.vertices.len())
+            .find(|&j| (pat.vertices[j][0] - q[0]).hypot(pat.vertices[j][1] - q[1]) <= 1e-9)
+            .map(|c| (g, c))
+    })
+    .flatten();
+    let input = RobustnessInput {
+        pattern: pat,
+        arm_faces: arm.faces.len(),
+        face_names,
+        vertex_names,
+        cylinders: &cylinders,
+        units,
+        tip,
+        t_max: model.t_max,
+        settings: task.robustness,
+    };
+    robustness::measure(&input).map_err(|e| e.to_string())
+}
+
+/// The model of a record's graph and candidate, and the record's free variables, all
+/// variables and mode signs.
+type Design = (Model, Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// Rebuild a recorded design ([`Design`]).
+fn design_of(
+    task: &Task,
+    graph: &CreaseGraph,
+    rec: &AlternativeRecord,
+) -> Result<Design, SearchError> {
+    let model = Model::new(graph, task, rec.candidate - 1)?;
+    let free: Vec<f64> = model
+        .free
+        .iter()
+        .map(|&i| {
+            rec.variables
+                .get(&model.plan.variables[i].name)
+                .copied()
+                .unwrap_or(model.var_bounds(i).0)
+        })
+        .collect();
+    let full = model.full_vars(&free);
+    let modes: Vec<f64> = rec
+        .modes
+        .iter()
+        .map(|m| if m == "up" { 1.0 } else { -1.0 })
+        .collect();
+    Ok((model, free, full, modes))
+}
+
+/// The robustness of a recorded design measured again by `check::robustness` on a sweep of
+/// `states` states (e.g. denser than the search's): `graph` is the record's graph (the
+/// enumeration's meaningful graphs, in order, indexed by `rec.graph`).
+pub fn remeasure(
+    task: &Task,
+    graph: &CreaseGraph,
+    rec: &AlternativeRecord,
+    states: usize,
+) -> Result<robustness::RobustnessReport, String> {
+    let (model, _, full, modes) = design_of(task, graph, rec).map_err(|e| e.to_string())?;
+    let design = Evaluated::new(&model.plan, full, modes);
+    let arm = design.pattern(&sample_times(model.t_max, states.max(2)));
+    let pat = checked_pattern(task, &arm)?;
+    measure_robustness(task, &model, &arm, &pat)
 }
 
 /// Run the search of `task` and write everything under `opts.out`.
@@ -440,6 +609,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         sweep: opts.sweep,
         foldsynth: env!("CARGO_PKG_VERSION").into(),
         rules: (opts.rules != Rules::default()).then(|| opts.rules.names()),
+        post_check_only: opts.post_check_only,
     };
     let opened = OutputDir::open(&opts.out, &settings, opts.resume, opts.force)?;
     for note in &opened.notes {
@@ -490,6 +660,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
             })
         })
         .collect();
+    let robust_spec = (!opts.post_check_only).then(|| RobustSpec::from_task(task, opts.sweep));
     progress.phase(
         "compile + optimize + check",
         "alternatives",
@@ -509,7 +680,10 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
                     if s.model.is_none() {
                         let t = Instant::now();
                         s.model =
-                            Some(prepare(graphs[alt.graph], task, alt.candidate).map(Arc::new));
+                            Some(
+                            prepare(graphs[alt.graph], task, alt.candidate, robust_spec.as_ref())
+                                .map(Arc::new),
+                        );
                         s.seconds += t.elapsed().as_secs_f64();
                     }
                     let m = s
@@ -588,8 +762,10 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         export_s: 0.0,
         total_s: 0.0,
     };
-    let feasible: Vec<&AlternativeRecord> =
+    let mut feasible: Vec<&AlternativeRecord> =
         records.iter().filter(|r| r.feasible_design()).collect();
+    // Most robust first (ties: enumeration order).
+    feasible.sort_by(|a, b| b.score().total_cmp(&a.score()));
     let mut summary = Summary {
         task: task.name.clone(),
         n_max,
@@ -625,7 +801,33 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         settings: json!({
             "starts": opts.starts, "seed": opts.seed, "jobs": pool.current_num_threads(),
             "sweep": opts.sweep, "resumed": finished.len(), "resume": resume,
+            "post_check_only": opts.post_check_only,
+            "optimize_states": robust_spec.as_ref().map(|s| s.states),
+            "robustness": {
+                "rigid_margin": task.robustness.rigid_margin,
+                "clearance": task.robustness.clearance,
+                "obstacle_clearance": task.robustness.obstacle_clearance,
+            },
         }),
+        meets_margins: feasible
+            .iter()
+            .filter(|r| r.robustness.as_ref().is_some_and(|x| x.meets_settings()))
+            .count(),
+        near_rigid_limit: feasible
+            .iter()
+            .filter(|r| {
+                r.robustness
+                    .as_ref()
+                    .is_some_and(|x| x.rigid_margin.value < 1e-3)
+            })
+            .count(),
+        ranking: feasible
+            .iter()
+            .map(|r| RankEntry {
+                id: r.id(),
+                score: r.robustness.as_ref().map(|x| x.score),
+            })
+            .collect(),
         designs: feasible.iter().map(|r| r.id()).collect(),
         cyclic: opts.rules.r2p.then(|| {
             CyclicCounts::count(
@@ -735,25 +937,9 @@ fn write_designs(
         "designs",
         Some(feasible.len() as u64),
     );
-    let write_one =
-        |rec: &&AlternativeRecord| -> Result<export::report::ReportDesign, SearchError> {
-            let model = Model::new(graphs[rec.graph], task, rec.candidate - 1)?;
-            let free: Vec<f64> = model
-                .free
-                .iter()
-                .map(|&i| {
-                    rec.variables
-                        .get(&model.plan.variables[i].name)
-                        .copied()
-                        .unwrap_or(model.var_bounds(i).0)
-                })
-                .collect();
-            let full = model.full_vars(&free);
-            let modes: Vec<f64> = rec
-                .modes
-                .iter()
-                .map(|m| if m == "up" { 1.0 } else { -1.0 })
-                .collect();
+    let write_one = |(rank, rec): (usize, &&AlternativeRecord)| -> Result<export::report::ReportDesign, SearchError> {
+            let rank = rank + 1;
+            let (model, free, full, modes) = design_of(task, graphs[rec.graph], rec)?;
             let design = Evaluated::new(&model.plan, full.clone(), modes);
             let pattern = design.pattern(&sample_times(model.t_max, 33));
             let meta = design_meta(task, &model, rec);
@@ -789,6 +975,8 @@ fn write_designs(
                 "verification": rec.verification,
                 "self_intersection_free": rec.self_intersection_free,
                 "obstacle_free": rec.obstacle_free,
+                "robustness": rec.robustness,
+                "rank": rank,
                 "pattern": pattern,
                 "meta": meta,
                 "svg": export::svg::svg_scale(&pattern, &Default::default()).ok(),
@@ -841,6 +1029,7 @@ fn write_designs(
     let cards: Vec<export::report::ReportDesign> = pool.install(|| {
         feasible
             .par_iter()
+            .enumerate()
             .map(write_one)
             .collect::<Result<Vec<_>, _>>()
     })?;

@@ -32,6 +32,7 @@
 mod drive;
 mod initial;
 pub mod number;
+mod robustness;
 
 use std::path::{Path, PathBuf};
 
@@ -40,6 +41,7 @@ use serde::Deserialize;
 pub use drive::Drive;
 pub use initial::{InitialCrease, InitialGraph, InitialVertex};
 pub use number::Number;
+pub use robustness::{DEFAULT_CLEARANCE, DEFAULT_RIGID_MARGIN, MAX_RIGID_MARGIN, Robustness};
 
 use crate::grammar::VertexType;
 
@@ -83,6 +85,9 @@ pub struct Task {
     pub objective: Option<Objective>,
     /// Intersection-check setup (Sec. 5.4.2), if given.
     pub check: Option<CheckSpec>,
+    /// Margins the optimizer keeps over the whole motion (`[robustness]`, defaults when
+    /// absent).
+    pub robustness: Robustness,
 }
 
 /// Symmetry of a design task.
@@ -143,7 +148,14 @@ pub struct CheckSpec {
     /// The design is one arm of a two-armed device: checks and pictures include a copy
     /// rotated 180° about the z-axis (the gripper, Sec. 5.5.1).
     pub second_arm: bool,
+    /// Number of evenly spaced states over [0, t_max] at which the optimizer imposes the
+    /// clearance and margin constraints (more are added where a finer sweep finds the
+    /// design closer than allowed).
+    pub optimize_states: usize,
 }
+
+/// Default of `[check] optimize_states`.
+pub const DEFAULT_OPTIMIZE_STATES: usize = 9;
 
 /// A cylinder obstacle (axis segment `a → b` and radius): the checks' own type, so the
 /// task, the intersection check and the pictures share one definition.
@@ -169,6 +181,7 @@ struct RawTask {
     bounds: Option<RawBounds>,
     objective: Option<RawObjective>,
     check: Option<RawCheck>,
+    robustness: Option<robustness::RawRobustness>,
 }
 
 #[derive(Deserialize)]
@@ -267,6 +280,7 @@ struct RawCheck {
     cylinders: Vec<RawCylinder>,
     #[serde(default)]
     second_arm: bool,
+    optimize_states: Option<i64>,
 }
 
 #[derive(Deserialize)]
@@ -522,6 +536,15 @@ impl Task {
                         ),
                     ));
                 }
+                let optimize_states = c.optimize_states.unwrap_or(DEFAULT_OPTIMIZE_STATES as i64);
+                if !(2..=crate::limits::STATES_MAX as i64).contains(&optimize_states) {
+                    return Err(cx.err(
+                        "check.optimize_states",
+                        format!(
+                            "{optimize_states} is not allowed: at least 2 states (0 and t_max), at most {}", crate::limits::STATES_MAX
+                        ),
+                    ));
+                }
                 let mut cylinders = Vec::new();
                 for (i, cy) in c.cylinders.iter().enumerate() {
                     let f = format!("check.cylinders[{i}]");
@@ -550,9 +573,12 @@ impl Task {
                     states: c.states as usize,
                     cylinders,
                     second_arm: c.second_arm,
+                    optimize_states: optimize_states as usize,
                 })
             }
         };
+
+        let robustness = robustness::build(&cx, raw.robustness.as_ref(), &initial)?;
 
         Ok(Task {
             name: name.trim().to_string(),
@@ -566,6 +592,7 @@ impl Task {
             bounds,
             objective,
             check,
+            robustness,
         })
     }
 }
