@@ -11,6 +11,7 @@
 pub mod check;
 pub mod cli;
 pub mod compile;
+pub mod cpu_time;
 pub mod export;
 pub mod expr;
 pub mod geom;
@@ -22,3 +23,4 @@ pub mod pattern;
 pub mod search;
 pub mod simulate;
 pub mod task;
+pub mod trig;

@@ -4,6 +4,7 @@ use super::record::{AlternativeRecord, Summary, Timings, level_distribution};
 use crate::check::verify::{Tolerances, verify};
 use crate::check::{CheckError, Cylinder, MotionSettings, check_frames, two_armed};
 use crate::compile::Options as CompileOptions;
+use crate::cpu_time::Stopwatch;
 use crate::export::{self, DesignMeta, ExportOptions};
 use crate::grammar::{CreaseGraph, Enumeration, Filters};
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
@@ -143,7 +144,7 @@ pub struct Prepared {
     pub compiled: CompiledModel,
 }
 
-/// A lazily compiled model (or why it failed) and the seconds it took.
+/// A lazily compiled model (or why it failed) and the CPU seconds it took.
 type CompiledSlot = (Result<Arc<Prepared>, String>, f64);
 
 /// Build and compile the model of one graph and candidate.
@@ -204,7 +205,7 @@ fn evaluate(
     let model = &p.model;
     let modes = alt.mode_signs();
     let key = alt.key();
-    let t0 = Instant::now();
+    let t0 = Stopwatch::start();
     let problem = ModelProblem::new(model, &p.compiled, &modes);
     let sol = minimize(
         &problem,
@@ -215,7 +216,7 @@ fn evaluate(
             ..Default::default()
         },
     );
-    let optimize_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let optimize_ms = t0.cpu_ms();
     let full = model.full_vars(&sol.x);
     let omega = model.omega(&full, &modes);
     let meets = sol.feasible && omega <= model.threshold;
@@ -255,7 +256,7 @@ fn evaluate(
     if !meets {
         return rec;
     }
-    let t1 = Instant::now();
+    let t1 = Stopwatch::start();
     let design = Evaluated::new(&model.plan, full, modes);
     let states = task.check.as_ref().map(|c| c.states).unwrap_or(16);
     let arm = design.pattern(&sample_times(model.t_max, states));
@@ -308,7 +309,7 @@ fn evaluate(
     }
     rec.verification_failed = Some(failed);
     rec.verification = Some(report);
-    rec.check_ms = t1.elapsed().as_secs_f64() * 1e3;
+    rec.check_ms = t1.cpu_ms();
     rec
 }
 
@@ -331,6 +332,7 @@ fn read_records(path: &Path) -> Result<Vec<AlternativeRecord>, SearchError> {
 /// Run the search of `task` and write everything under `opts.out`.
 pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     let start = Instant::now();
+    let cpu0 = crate::cpu_time::process_seconds();
     let terr = |m: &str| SearchError::Task {
         task: task.name.clone(),
         message: m.to_string(),
@@ -457,9 +459,9 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
             .filter_map(|alt| {
                 let slot = &cache[alt.graph * 3 + alt.candidate];
                 let (prepared, _) = slot.get_or_init(|| {
-                    let t = Instant::now();
+                    let t = Stopwatch::start();
                     let p = prepare(graphs[alt.graph], task, alt.candidate).map(Arc::new);
-                    (p, t.elapsed().as_secs_f64())
+                    (p, t.cpu_ms() / 1e3)
                 });
                 let prepared = match prepared {
                     Ok(p) => p.clone(),
@@ -499,6 +501,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         check_s: records.iter().map(|r| r.check_ms).sum::<f64>() / 1e3,
         export_s: 0.0,
         total_s: 0.0,
+        cpu_s: 0.0,
     };
     let feasible: Vec<&AlternativeRecord> =
         records.iter().filter(|r| r.feasible_design()).collect();
@@ -546,6 +549,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     write_designs(task, &graphs, &enumeration, &feasible, &summary, opts)?;
     timings.export_s = t2.elapsed().as_secs_f64();
     timings.total_s = start.elapsed().as_secs_f64();
+    timings.cpu_s = crate::cpu_time::process_seconds() - cpu0;
     summary.timings = timings;
     let path = opts.out.join("summary.json");
     fs::write(
