@@ -14,7 +14,7 @@ pub struct SynthesizeArgs {
     /// Output directory (default: out/<task name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Worker threads (default: one per core).
+    /// Worker threads; 0 means one per core.
     #[arg(long, default_value_t = 0)]
     pub jobs: usize,
     /// Starting points per design alternative.
@@ -29,10 +29,12 @@ pub struct SynthesizeArgs {
     /// Override the task's maximum number of internal vertices.
     #[arg(long)]
     pub n_max: Option<usize>,
-    /// States of the rigidity/verification sweep over [0, t_max].
+    /// States of the rigidity/verification sweep over [0, t_max] (181: every 0.5° of a
+    /// π/2 motion; `model --sweep` has the same default).
     #[arg(long, default_value_t = SearchOptions::default().sweep)]
     pub sweep: usize,
-    /// Skip the FOLD/SVG/OBJ/STL/picture/animation files and the report.
+    /// Skip the per-design FOLD/SVG/OBJ/STL/picture/animation files (the design JSONs and
+    /// report.html, with its 3D views, are written either way).
     #[arg(long)]
     pub no_export: bool,
     /// Print the summary as JSON.
@@ -64,11 +66,18 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         progress: true,
     };
     let summary = search::run(&task, &opts)?;
+    let files = format!(
+        "report: {}\nsummary: {}\n",
+        out.join("report.html").display(),
+        out.join("summary.json").display()
+    );
     if args.json {
+        // stdout stays one JSON document; the file names go to stderr.
         println!("{}", serde_json::to_string_pretty(&summary)?);
+        eprint!("{files}");
     } else {
         print!("{}", summary.text());
-        println!("results in {}", out.display());
+        print!("{files}");
     }
     if summary.verification_failures > 0 {
         anyhow::bail!(

@@ -9,8 +9,11 @@
 //! `OUT/alternatives.jsonl` one line per alternative as it finishes, so a killed run
 //! loses nothing and `--resume` skips what is done.
 
+mod progress;
 mod record;
+mod report;
 mod run;
 
+pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
 pub use record::{AlternativeRecord, Summary, Timings, level_distribution};
 pub use run::{Alternative, SearchError, SearchOptions, prepare, run};

@@ -1,6 +1,8 @@
 //! Running a search: scheduling, streaming, resuming, summarizing, exporting.
 
+use super::progress::Progress;
 use super::record::{AlternativeRecord, Summary, Timings, level_distribution};
+use super::report::{report_design, report_input, task_facts};
 use crate::check::verify::{Tolerances, verify};
 use crate::check::{CheckError, Cylinder, MotionSettings, check_frames, two_armed};
 use crate::compile::Options as CompileOptions;
@@ -13,12 +15,11 @@ use crate::model::{Model, ModelError};
 use crate::optimize::{self, minimize};
 use crate::pattern::Pattern;
 use crate::task::Task;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use serde_json::json;
 use std::collections::{BTreeMap, HashMap};
 use std::fs::{self, File, OpenOptions};
-use std::io::{BufRead, BufReader, IsTerminal, Write};
+use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
@@ -40,9 +41,11 @@ pub struct SearchOptions {
     pub n_max: Option<usize>,
     /// States of the verification sweep over [0, t_max].
     pub sweep: usize,
-    /// Write FOLD/SVG/OBJ/STL/pictures/GIF for every feasible design and the report.
+    /// Write FOLD/SVG/OBJ/STL/pictures/GIF for every feasible design (the design JSONs and
+    /// the report are written either way).
     pub export: bool,
-    /// Show a progress bar on stderr (only drawn on a terminal).
+    /// Show progress on stderr: a bar on a terminal, a status line every few seconds
+    /// otherwise (see [`Progress`]).
     pub progress: bool,
 }
 
@@ -355,10 +358,18 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         return Err(terr("N_max = 0: there is nothing to extend"));
     }
 
+    let progress = Progress::new(opts.progress);
+    progress.phase("enumerate graphs", "graphs", None);
     let t0 = Instant::now();
     let enumeration = Enumeration::run(task, n_max, Filters::all());
     let graphs: Vec<&CreaseGraph> = enumeration.meaningful().map(|n| &n.graph).collect();
     let enumerate_s = t0.elapsed().as_secs_f64();
+    progress.inc(graphs.len() as u64);
+    progress.finish_phase_with(&format!(
+        "{} generated, {} meaningful",
+        enumeration.nodes.len(),
+        graphs.len()
+    ));
 
     let mut alternatives = Vec::new();
     for (g, graph) in graphs.iter().enumerate() {
@@ -437,19 +448,11 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
 
     let cache: Vec<OnceLock<CompiledSlot>> =
         (0..graphs.len() * 3).map(|_| OnceLock::new()).collect();
-    let bar = if opts.progress && std::io::stderr().is_terminal() {
-        let b =
-            ProgressBar::with_draw_target(Some(todo.len() as u64), ProgressDrawTarget::stderr());
-        b.set_style(
-            ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} alternatives ({eta}) {msg}",
-            )
-            .expect("valid template"),
-        );
-        b
-    } else {
-        ProgressBar::hidden()
-    };
+    progress.phase(
+        "compile + optimize + check",
+        "alternatives",
+        Some(todo.len() as u64),
+    );
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
         .build()
@@ -471,7 +474,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
                             alt.sequence,
                             alt.candidate + 1
                         );
-                        bar.inc(1);
+                        progress.inc(1);
                         return None;
                     }
                 };
@@ -481,12 +484,12 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
                     // Each line is flushed as it is written: a kill loses at most this one.
                     let _ = writeln!(w, "{line}").and_then(|_| w.flush());
                 }
-                bar.inc(1);
+                progress.inc(1);
                 Some(rec)
             })
             .collect()
     });
-    bar.finish_and_clear();
+    progress.finish_phase();
 
     let mut records = done;
     records.extend(new);
@@ -546,7 +549,15 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
 
     let t2 = Instant::now();
     summary.timings.total_s = start.elapsed().as_secs_f64();
-    write_designs(task, &graphs, &enumeration, &feasible, &summary, opts)?;
+    write_designs(
+        task,
+        &graphs,
+        &enumeration,
+        &feasible,
+        &summary,
+        opts,
+        &progress,
+    )?;
     timings.export_s = t2.elapsed().as_secs_f64();
     timings.total_s = start.elapsed().as_secs_f64();
     timings.cpu_s = crate::cpu_time::process_seconds() - cpu0;
@@ -580,7 +591,8 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
                 }
             })
             .collect(),
-        gripping_vertex: Some(model.gripping),
+        // The vertex name (1-based), as in the rule sequence and the record.
+        gripping_vertex: Some(model.plan.vertices[model.gripping].name),
         objective: Some(rec.objective),
         targets: model
             .targets
@@ -604,8 +616,8 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
     }
 }
 
-/// Write `designs/<id>.json` for every feasible design and, with export, its files and
-/// the report.
+/// Write `designs/<id>.json` for every feasible design, with export its files, and the
+/// report (always: its 3D views need only the geometry).
 fn write_designs(
     task: &Task,
     graphs: &[&CreaseGraph],
@@ -613,6 +625,7 @@ fn write_designs(
     feasible: &[&AlternativeRecord],
     summary: &Summary,
     opts: &SearchOptions,
+    progress: &Progress,
 ) -> Result<(), SearchError> {
     let dir = opts.out.join("designs");
     if dir.exists() {
@@ -620,8 +633,17 @@ fn write_designs(
     }
     fs::create_dir_all(&dir).map_err(io(&dir))?;
     // Designs are independent: write them in parallel, keep the cards in order.
+    progress.phase(
+        if opts.export {
+            "write designs and their files"
+        } else {
+            "write design JSONs"
+        },
+        "designs",
+        Some(feasible.len() as u64),
+    );
     let write_one =
-        |rec: &&AlternativeRecord| -> Result<Option<export::report::ReportDesign>, SearchError> {
+        |rec: &&AlternativeRecord| -> Result<export::report::ReportDesign, SearchError> {
             let model = Model::new(graphs[rec.graph], task, rec.candidate - 1)?;
             let free: Vec<f64> = model
                 .free
@@ -684,7 +706,16 @@ fn write_designs(
             )
             .map_err(io(&path))?;
             if !opts.export {
-                return Ok(None);
+                progress.inc(1);
+                return Ok(report_design(
+                    rec,
+                    model.threshold,
+                    pattern,
+                    meta,
+                    path,
+                    None,
+                    None,
+                ));
             }
             let out = dir.join(&id);
             let eo = ExportOptions {
@@ -698,163 +729,38 @@ fn write_designs(
             if !check.ok {
                 eprintln!("BUG: the exported FOLD file of {id} fails verification");
             }
-            Ok(Some(export::report::ReportDesign {
-                title: format!(
-                    "{} — candidate {} — {}",
-                    rec.sequence,
-                    rec.candidate,
-                    rec.modes.join(", ")
-                ),
+            progress.inc(1);
+            Ok(report_design(
+                rec,
+                model.threshold,
+                pattern,
                 meta,
-                files,
-                verify: Some(check),
-            }))
+                path,
+                Some(files),
+                Some(check),
+            ))
         };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
         .build()
         .map_err(|e| SearchError::Export(e.to_string()))?;
-    let cards: Vec<export::report::ReportDesign> = pool
-        .install(|| {
-            feasible
-                .par_iter()
-                .map(write_one)
-                .collect::<Result<Vec<_>, _>>()
-        })?
-        .into_iter()
-        .flatten()
-        .collect();
-    if opts.export {
-        let input = report_input(task, enumeration, summary, cards);
-        export::report::write_report(&opts.out, &input)
-            .map_err(|e| SearchError::Export(e.to_string()))?;
-    }
+    let cards: Vec<export::report::ReportDesign> = pool.install(|| {
+        feasible
+            .par_iter()
+            .map(write_one)
+            .collect::<Result<Vec<_>, _>>()
+    })?;
+    progress.phase("write report", "", None);
+    let input = report_input(
+        task,
+        enumeration,
+        summary,
+        task_facts(task, opts, summary),
+        cards,
+    );
+    let path = export::report::write_report(&opts.out, &input)
+        .map_err(|e| SearchError::Export(e.to_string()))?;
+    let bytes = fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    progress.finish_phase_with(&format!("{} ({bytes} bytes)", path.display()));
     Ok(())
-}
-
-/// The report's content.
-fn report_input(
-    task: &Task,
-    enumeration: &Enumeration,
-    s: &Summary,
-    designs: Vec<export::report::ReportDesign>,
-) -> export::report::ReportInput {
-    use export::plots::{DistributionPlot, NodeStatus, Series, TreeNode};
-    use export::report::{CountRow, ReportInput, ReportSummary, TimingRow};
-    let th = |i: usize| s.thesis.map(|t| t[i] as u64);
-    let counts = vec![
-        CountRow {
-            label: "meaningful graphs".into(),
-            value: s.graphs as u64,
-            thesis: s.thesis.map(|_| 52),
-        },
-        CountRow {
-            label: "alternatives evaluated".into(),
-            value: s.alternatives as u64,
-            thesis: th(0),
-        },
-        CountRow {
-            label: "meet the target".into(),
-            value: s.meets_target as u64,
-            thesis: th(1),
-        },
-        CountRow {
-            label: "… free of self-intersection".into(),
-            value: s.no_self_intersection as u64,
-            thesis: th(2),
-        },
-        CountRow {
-            label: "… also clear of the obstacles".into(),
-            value: s.no_intersection as u64,
-            thesis: th(3),
-        },
-        CountRow {
-            label: "… also rigid over the whole motion".into(),
-            value: s.feasible as u64,
-            thesis: None,
-        },
-        CountRow {
-            label: "rigid at t_max only (thesis check passes, full motion fails)".into(),
-            value: s.rigid_at_tmax_only as u64,
-            thesis: None,
-        },
-        CountRow {
-            label: "verification failures".into(),
-            value: s.verification_failures as u64,
-            thesis: None,
-        },
-    ];
-    let t = &s.timings;
-    let timings = vec![
-        TimingRow {
-            stage: "enumerate (wall)".into(),
-            seconds: t.enumerate_s,
-        },
-        TimingRow {
-            stage: "compile (CPU)".into(),
-            seconds: t.compile_s,
-        },
-        TimingRow {
-            stage: "optimize (CPU)".into(),
-            seconds: t.optimize_s,
-        },
-        TimingRow {
-            stage: "check + verify (CPU)".into(),
-            seconds: t.check_s,
-        },
-    ];
-    let tree = enumeration
-        .nodes
-        .iter()
-        .enumerate()
-        .map(|(i, n)| TreeNode {
-            id: i,
-            parent: n.parent,
-            label: n.graph.sequence(),
-            level: n.level,
-            status: match n.status {
-                crate::grammar::Status::Meaningful => NodeStatus::Meaningful,
-                crate::grammar::Status::Invalid => NodeStatus::Invalid,
-                crate::grammar::Status::Mirror => NodeStatus::Mirror,
-                crate::grammar::Status::Isomorphic => NodeStatus::Isomorphic,
-            },
-        })
-        .collect();
-    let series = |name: &str, f: &dyn Fn(&super::record::LevelCounts) -> usize| Series {
-        name: name.into(),
-        points: s
-            .levels
-            .iter()
-            .map(|l| [l.level as f64, f(l) as f64])
-            .collect(),
-    };
-    let distribution = DistributionPlot {
-        title: format!(
-            "{}: designs over rule applications (thesis Fig. 51)",
-            task.name
-        ),
-        x_label: "rule applications".into(),
-        y_label: "designs".into(),
-        series: vec![
-            series("all", &|l| l.alternatives),
-            series("meet the target", &|l| l.meets_target),
-            series("no self-intersection", &|l| l.no_self_intersection),
-            series("no intersection", &|l| l.no_intersection),
-        ],
-    };
-    ReportInput {
-        summary: ReportSummary {
-            title: format!("foldsynth — {}", task.name),
-            task: task.name.clone(),
-            counts,
-            timings,
-            notes: vec![format!(
-                "{} starting points per alternative, seed {}, {} workers; the search took {:.1} s wall before writing these files.",
-                s.settings["starts"], s.settings["seed"], s.settings["jobs"], t.total_s
-            )],
-        },
-        tree,
-        distribution: Some(distribution),
-        designs,
-    }
 }
