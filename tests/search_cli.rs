@@ -73,8 +73,12 @@ fn same_seed_same_results_and_a_resumed_run_matches() {
     assert_eq!(ra.len(), 66);
     assert_eq!(ra, rb, "same seed, different results");
 
-    // Kill halfway: keep the first half of the lines and a torn line, then resume.
+    // Kill halfway: a run of the same settings (its manifest and settings) with the first
+    // half of the lines and a torn line, then resume.
     std::fs::create_dir_all(&c).unwrap();
+    for f in ["manifest.json", "settings.json"] {
+        std::fs::copy(a.join(f), c.join(f)).unwrap();
+    }
     let text = std::fs::read_to_string(a.join("alternatives.jsonl")).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     let mut partial = lines[..lines.len() / 2].join("\n");
@@ -86,6 +90,11 @@ fn same_seed_same_results_and_a_resumed_run_matches() {
         &["--no-export", "--jobs", "2", "--seed", "7", "--resume"],
     );
     assert_eq!(sc["settings"]["resumed"], lines.len() / 2);
+    // The torn line is reported as dropped, with its line number.
+    let dropped = sc["settings"]["resume"]["dropped"].as_array().unwrap();
+    assert_eq!(dropped.len(), 1, "{dropped:?}");
+    assert_eq!(dropped[0]["line"], lines.len() / 2 + 1);
+    assert!(dropped[0]["why"].as_str().unwrap().contains("torn"));
     assert_eq!(counts(&sc), counts(&sa));
     assert_eq!(records(&c), ra, "resumed run differs");
     assert_eq!(sc["designs"], sa["designs"]);
@@ -104,6 +113,7 @@ fn same_seed_same_results_and_a_resumed_run_matches() {
         "--resume",
     ]);
     assert!(!r.status.success());
+    assert_eq!(r.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&r.stderr).contains("other settings"));
 }
 

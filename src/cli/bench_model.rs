@@ -10,7 +10,9 @@ use crate::compile::Options;
 use crate::expr::Tape;
 use crate::grammar::CreaseGraph;
 use crate::model::Model;
-use crate::model::compiled::{CompiledModel, ModelProblem, objective_target, outputs_f64};
+use crate::model::compiled::{
+    CompiledModel, ModelProblem, objective_target, outputs_f64, symbolic,
+};
 use crate::optimize;
 use crate::task::Task;
 use anyhow::{Context, Result, bail};
@@ -34,11 +36,15 @@ pub struct ModelBenchArgs {
     #[arg(long, default_value_t = 1)]
     pub candidate: usize,
     /// Milliseconds of measurement per row.
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u64).range(1..=crate::limits::BENCH_MILLIS_MAX))]
     pub millis: u64,
     /// Print one JSON object (times in nanoseconds, compile times in milliseconds).
     #[arg(long)]
     pub json: bool,
+    /// Also run peer implementations in this invocation (only `symbolica` covers whole
+    /// models; the CasADi peer covers `bench vertex`).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub peer: Vec<super::bench::Peer>,
 }
 
 /// Run `foldsynth bench model`.
@@ -48,6 +54,9 @@ pub fn run(args: ModelBenchArgs) -> Result<()> {
         .with_context(|| format!("--graph '{}'", args.graph))?;
     if !(1..=3).contains(&args.candidate) {
         bail!("--candidate must be 1, 2 or 3");
+    }
+    if args.peer.contains(&super::bench::Peer::Casadi) {
+        bail!("--peer casadi: the CasADi peer covers `bench vertex` only; use --peer symbolica");
     }
     let model = Model::new(&graph, &task, args.candidate - 1)?;
     let modes = parse_modes(args.modes.as_deref(), model.plan.internal.len())?;
@@ -123,8 +132,31 @@ pub fn run(args: ModelBenchArgs) -> Result<()> {
         let (a, b) = (buf[k], tbuf[k]);
         (a - v).abs() <= 1e-12 * v.abs().max(1.0) && (b - v).abs() <= 1e-12 * v.abs().max(1.0)
     });
+    let symbolica = if args.peer.contains(&super::bench::Peer::Symbolica) {
+        let (ctx, outputs) = symbolic(&model);
+        let mut named = vec![("objective".to_string(), ctx.node_id(&outputs[0]))];
+        for (k, o) in outputs[1..].iter().enumerate() {
+            named.push((format!("g{}", k + 1), ctx.node_id(o)));
+        }
+        let job = super::bench_symbolica::PeerJob {
+            graph: ctx.to_graph(),
+            outputs: named,
+            names: super::formulas::model_names(&model),
+            n_vars: n,
+            n_params: params.len(),
+        };
+        let inputs: Vec<f64> = x.iter().chain(&params).copied().collect();
+        let mut s = super::bench_symbolica::SymbolicaPeer::new(job, inputs, &buf, 3)?;
+        // Rounds of a fifth of the budget per row, like the rows above in total.
+        for _ in 0..5 {
+            s.round(budget / 5)?;
+        }
+        Some(s)
+    } else {
+        None
+    };
 
-    let out = json!({
+    let mut out = json!({
         "task": task.name, "graph": model.plan.sequence, "variables": n,
         "constraints": compiled.n_constraints,
         "jit_value_ns": jit_v, "jit_value_grad_ns": jit_vg,
@@ -134,6 +166,11 @@ pub fn run(args: ModelBenchArgs) -> Result<()> {
         "ops_before": rep.input.ops, "ops_after": rep.simplified.ops, "ops_gradient": rep.with_gradients.ops,
         "values_agree": agree, "at_optimum": sol.feasible,
     });
+    if let Some(s) = &symbolica {
+        out["symbolica"] = s.json();
+        out["symbolica_value_grad_ratio"] = json!(jit_vg / s.value_grad_ns());
+        out["symbolica_compile_ratio"] = json!(compile_ms / s.compile_ms());
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
@@ -176,5 +213,10 @@ pub fn run(args: ModelBenchArgs) -> Result<()> {
         rep.with_gradients.ops
     );
     println!("JIT, interpreter and f64 agree to 1e-12: {agree}");
+    if let Some(s) = &symbolica {
+        for l in s.lines(jit_vg, compile_ms) {
+            println!("{l}");
+        }
+    }
     Ok(())
 }

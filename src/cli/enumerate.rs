@@ -3,15 +3,12 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use serde::Serialize;
 
 use crate::grammar::{Enumeration, Filters, Status};
-use crate::task::{N_MAX_LIMIT, Task};
-
-/// Graph budget: every generated graph is kept (about 10 kB each), so this bounds memory
-/// to about 3 GB. Without the isomorphism filter N_max = 5 exceeds it.
-const MAX_GRAPHS: usize = 200_000;
+use crate::limits::{GRAPHS_MAX, N_MAX};
+use crate::task::Task;
 
 /// Output format.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -27,8 +24,8 @@ pub enum Format {
 pub struct EnumerateArgs {
     /// The task file (e.g. grammar/gripper.toml).
     pub task: PathBuf,
-    /// Maximum number of internal vertices (default: the task's grammar.n_max).
-    #[arg(long)]
+    /// Maximum number of internal vertices (default: the task's grammar.n_max), 0 to 6.
+    #[arg(long, value_parser = crate::limits::count::<0, { N_MAX as u64 }>)]
     pub n_max: Option<usize>,
     /// Keep graphs isomorphic to earlier ones.
     #[arg(long)]
@@ -78,15 +75,15 @@ struct Report {
 pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
     let task = Task::load(&args.task)?;
     let n_max = args.n_max.unwrap_or(task.n_max);
-    if n_max > N_MAX_LIMIT {
-        bail!("--n-max {n_max} is out of range: allowed 0..={N_MAX_LIMIT}");
-    }
     let filters = Filters {
         isomorphism: !args.no_iso,
         mirror: !args.no_mirror,
         validity: !args.no_validity,
     };
-    let e = Enumeration::run_limited(&task, n_max, filters, MAX_GRAPHS)?;
+    // Every generated graph is kept (about 15 kB each): what does not fit the budget is
+    // refused with its estimated size, before memory runs out.
+    let e = Enumeration::run_within(&task, n_max, filters, GRAPHS_MAX)
+        .map_err(|est| anyhow::anyhow!("{}", est.refusal(&task.name, n_max, filters)))?;
     if let Some(path) = &args.tree {
         std::fs::write(path, e.to_dot())
             .with_context(|| format!("cannot write the search tree to {}", path.display()))?;

@@ -5,10 +5,12 @@ use clap::{Parser, Subcommand};
 pub mod bench;
 pub mod bench_model;
 pub mod bench_numeric;
+pub mod bench_symbolica;
 pub mod compile;
 pub mod enumerate;
 pub mod export;
 pub mod formulas;
+pub mod fuzz;
 pub mod model;
 pub mod optimize_flasher;
 pub mod simulate;
@@ -50,6 +52,42 @@ pub enum Command {
     Simulate(simulate::SimulateArgs),
     /// Optimize the adapted flasher by simulated annealing (thesis Sec. 3.6-3.7).
     OptimizeFlasher(optimize_flasher::OptimizeFlasherArgs),
+    /// Fuzz every parser: generated and mutated inputs, panics, aborts and hangs reported.
+    Fuzz(fuzz::FuzzArgs),
+}
+
+/// A check the command ran failed (`verify`, `simulate` compared with the PTU, a
+/// synthesis whose designs fail verification): exit status 1. Every other error is bad
+/// input or usage: exit status 2.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct CheckFailed(pub String);
+
+/// The exit status of a failed command: 1 when a check it ran failed, 2 otherwise (bad
+/// input, usage, a file that cannot be read or written).
+pub fn exit_code(e: &anyhow::Error) -> u8 {
+    if e.downcast_ref::<CheckFailed>().is_some() {
+        1
+    } else {
+        2
+    }
+}
+
+/// The message of an error and its causes, each said once (an I/O error wrapped with its
+/// path is not repeated), every line cut to a readable length.
+pub fn error_text(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let c = cause.to_string();
+        if c.is_empty() || text.contains(&c) {
+            continue;
+        }
+        if !text.is_empty() {
+            text.push_str(": ");
+        }
+        text.push_str(&c);
+    }
+    crate::text::cut_lines(&text, 1000)
 }
 
 /// Run one parsed command line.
@@ -66,5 +104,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Verify(a) => verify::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::OptimizeFlasher(a) => optimize_flasher::run(a),
+        Command::Fuzz(a) => fuzz::run(a),
     }
 }

@@ -1,12 +1,12 @@
 //! `foldsynth model TASK --graph SEQ [--modes …] [--candidate K] [--at VARS.json]
-//! [--formulas FORMAT] [--json]`: the optimization model of one graph, compiled, evaluated
-//! and verified.
+//! [--formulas FORMAT [--no-simplify] [--gradient] [--output FILE]] [--json]`: the
+//! optimization model of one graph, compiled, evaluated and verified.
 
 use crate::check::verify::{Tolerances, verify};
 use crate::compile::Options;
-use crate::expr::{Format, Names, print::print};
+use crate::expr::Format;
 use crate::grammar::{CreaseGraph, VarKind};
-use crate::model::compiled::{CompiledModel, ModelProblem, objective_target, symbolic};
+use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
 use crate::model::{Model, Plan};
 use crate::task::Task;
@@ -34,21 +34,32 @@ pub struct ModelArgs {
     #[arg(long, value_name = "VARS.json")]
     pub at: Option<PathBuf>,
     /// Print the objective and constraint formulas in this format
-    /// (plain, latex, mathematica, python, dot).
+    /// (plain, latex, mathematica, python, dot), simplified by egg, with a header that
+    /// says what each simplification removed.
     #[arg(long, value_name = "FORMAT")]
     pub formulas: Option<String>,
+    /// With --formulas: print the graph as built, before egg.
+    #[arg(long, requires = "formulas")]
+    pub no_simplify: bool,
+    /// With --formulas: also print the gradient of the objective and of every constraint
+    /// with respect to the free variables.
+    #[arg(long, requires = "formulas")]
+    pub gradient: bool,
+    /// With --formulas: write them to this file instead of standard output.
+    #[arg(long, value_name = "FILE", requires = "formulas")]
+    pub output: Option<PathBuf>,
     /// Optimize this alternative first (multi-start augmented Lagrangian), then evaluate
     /// and verify at the optimum.
     #[arg(long)]
     pub optimize: bool,
-    /// Starting points for --optimize.
-    #[arg(long, default_value_t = 32)]
+    /// Starting points for --optimize, 1 to 1000.
+    #[arg(long, default_value_t = 32, value_parser = crate::limits::count::<1, { crate::limits::STARTS_MAX as u64 }>)]
     pub starts: usize,
     /// Seed for --optimize.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Number of states of the verification sweep over [0, t_max] (as `synthesize --sweep`).
-    #[arg(long, default_value_t = crate::search::SearchOptions::default().sweep)]
+    /// Number of states of the verification sweep over [0, t_max] (as `synthesize --sweep`), 2 to 10000.
+    #[arg(long, default_value_t = crate::search::SearchOptions::default().sweep, value_parser = crate::limits::count::<2, { crate::limits::SWEEP_MAX as u64 }>)]
     pub sweep: usize,
     /// Print JSON.
     #[arg(long)]
@@ -78,8 +89,8 @@ pub fn parse_modes(text: Option<&str>, n: usize) -> Result<Vec<f64>> {
 
 /// Read variable values for the model's free variables from a JSON file.
 pub fn read_vars(model: &Model, path: &Path) -> Result<Vec<f64>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::limits::read_text(path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("{}: not valid JSON", path.display()))?;
     let obj = v.get("variables").unwrap_or(&v);
@@ -149,6 +160,18 @@ pub fn run(args: ModelArgs) -> Result<()> {
     let model = Model::from_plan(plan, &task, args.candidate - 1)?;
     let n = model.plan.internal.len();
     let modes = parse_modes(args.modes.as_deref(), n)?;
+    if let Some(fmt) = &args.formulas {
+        let format: Format = fmt
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--formulas: {e}"))?;
+        let opts = super::formulas::ModelFormulaOptions {
+            format,
+            simplify: !args.no_simplify,
+            gradient: args.gradient,
+        };
+        let text = super::formulas::model_formulas(&model, &task.name, opts)?;
+        return super::formulas::emit(&text, args.output.as_deref());
+    }
     let mut x = match &args.at {
         Some(p) => read_vars(&model, p)?,
         None => middle(&model),
@@ -191,30 +214,6 @@ pub fn run(args: ModelArgs) -> Result<()> {
         .map(|k| buf[layout.value(k + 1)])
         .collect();
     let gripping = model.plan.vertices[model.gripping].name;
-
-    if let Some(fmt) = &args.formulas {
-        let format: Format = fmt
-            .parse()
-            .map_err(|e| anyhow::anyhow!("--formulas: {e}"))?;
-        let (ctx, outputs) = symbolic(&model);
-        let mut named = vec![("objective".to_string(), ctx.node_id(&outputs[0]))];
-        for (k, o) in outputs[1..].iter().enumerate() {
-            named.push((format!("g{}", k + 1), ctx.node_id(o)));
-        }
-        let names = Names {
-            vars: model
-                .free
-                .iter()
-                .map(|&i| ascii_name(&model.plan.variables[i].name))
-                .collect(),
-            params: (0..n)
-                .map(|k| format!("M{}", k + 1))
-                .chain((0..model.times.len()).map(|k| format!("t{k}")))
-                .collect(),
-        };
-        println!("{}", print(&ctx.graph(), &named, &names, format));
-        return Ok(());
-    }
 
     if args.json {
         let variables: Vec<_> = model
@@ -340,9 +339,4 @@ fn kind(k: VarKind) -> &'static str {
         VarKind::Sector => "sector",
         VarKind::Length => "length",
     }
-}
-
-/// Variable names for printers that need identifiers (α_5 → alpha_5, l_2,5 → l_2_5).
-fn ascii_name(name: &str) -> String {
-    name.replace('α', "alpha").replace([',', '\''], "_")
 }

@@ -1,7 +1,8 @@
-//! `foldsynth synthesize TASK [--out DIR] [--jobs N] [--starts K] [--seed S] [--resume]`:
-//! the whole method on a design task.
+//! `foldsynth synthesize TASK [--out DIR] [--jobs N] [--starts K] [--seed S] [--resume]
+//! [--force]`: the whole method on a design task.
 
-use crate::search::{self, SearchOptions};
+use crate::limits;
+use crate::search::{self, SearchOptions, output};
 use crate::task::Task;
 use anyhow::Result;
 use std::path::PathBuf;
@@ -11,27 +12,33 @@ use std::path::PathBuf;
 pub struct SynthesizeArgs {
     /// The task file (e.g. grammar/gripper.toml).
     pub task: PathBuf,
-    /// Output directory (default: out/<task name>).
+    /// Output directory (default: out/<task name>). It must be new, empty, or an earlier
+    /// run of the same settings (see --force).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Worker threads; 0 means one per core.
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads, 0 (one per core) to 256.
+    #[arg(long, default_value_t = 0, value_parser = limits::count::<0, { limits::JOBS_MAX as u64 }>)]
     pub jobs: usize,
-    /// Starting points per design alternative.
-    #[arg(long, default_value_t = SearchOptions::default().starts)]
+    /// Starting points per design alternative, 1 to 1000.
+    #[arg(long, default_value_t = SearchOptions::default().starts, value_parser = limits::count::<1, { limits::STARTS_MAX as u64 }>)]
     pub starts: usize,
     /// Seed of the starting points (same seed, same results).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Continue a killed run: keep the alternatives already in OUT/alternatives.jsonl.
+    /// Continue a killed run of the same settings: keep the alternatives already in
+    /// OUT/alternatives.jsonl (says how many it reused and why it dropped any).
     #[arg(long)]
     pub resume: bool,
-    /// Override the task's maximum number of internal vertices.
+    /// Use OUT even if it holds a run of other settings (its files, as its manifest.json
+    /// lists them, are deleted) or is not a foldsynth run (nothing is deleted).
     #[arg(long)]
+    pub force: bool,
+    /// Override the task's maximum number of internal vertices, 1 to 6.
+    #[arg(long, value_parser = limits::count::<1, { limits::N_MAX as u64 }>)]
     pub n_max: Option<usize>,
-    /// States of the rigidity/verification sweep over [0, t_max] (181: every 0.5° of a
-    /// π/2 motion; `model --sweep` has the same default).
-    #[arg(long, default_value_t = SearchOptions::default().sweep)]
+    /// States of the rigidity/verification sweep over [0, t_max], 2 to 10000 (181: every
+    /// 0.5° of a π/2 motion; `model --sweep` has the same default).
+    #[arg(long, default_value_t = SearchOptions::default().sweep, value_parser = limits::count::<2, { limits::SWEEP_MAX as u64 }>)]
     pub sweep: usize,
     /// Skip the per-design FOLD/SVG/OBJ/STL/picture/animation files (the design JSONs and
     /// report.html, with its 3D views, are written either way).
@@ -45,23 +52,16 @@ pub struct SynthesizeArgs {
 /// Run `foldsynth synthesize`.
 pub fn run(args: SynthesizeArgs) -> Result<()> {
     let task = Task::load(&args.task)?;
-    if args.starts == 0 {
-        anyhow::bail!("--starts must be at least 1");
-    }
-    if args.n_max == Some(0) {
-        anyhow::bail!("--n-max must be at least 1");
-    }
-    let out = args
-        .out
-        .unwrap_or_else(|| PathBuf::from("out").join(&task.name));
+    let out = args.out.unwrap_or_else(|| output::default_dir(&task.name));
     let opts = SearchOptions {
         out: out.clone(),
         jobs: args.jobs,
         starts: args.starts,
         seed: args.seed,
         resume: args.resume,
+        force: args.force,
         n_max: args.n_max,
-        sweep: args.sweep.max(2),
+        sweep: args.sweep,
         export: !args.no_export,
         progress: true,
     };
@@ -80,10 +80,11 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         print!("{files}");
     }
     if summary.verification_failures > 0 {
-        anyhow::bail!(
+        return Err(super::CheckFailed(format!(
             "{} designs failed verification (a bug; see the messages above)",
             summary.verification_failures
-        );
+        ))
+        .into());
     }
     Ok(())
 }

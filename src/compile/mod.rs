@@ -27,6 +27,8 @@
 //! builder) behind [`jit`] (in process) and [`aot`] (object, shared library, C header); [`dual`] is
 //! the forward-mode oracle the tests hold the differentiator to; [`vertex`] builds the
 //! symbolic PTU of one vertex (for `foldsynth formulas` and `foldsynth bench vertex`).
+//! With the cargo feature `symbolica`, `symbolica` is the second pipeline and printer
+//! built on Symbolica (on its own thread).
 
 pub mod aot;
 pub mod codegen;
@@ -35,6 +37,8 @@ pub mod dual;
 pub mod jacobian;
 pub mod jit;
 pub mod simplify;
+#[cfg(feature = "symbolica")]
+pub mod symbolica;
 pub mod vertex;
 
 pub use codegen::{CompileError, Math, OptLevel};

@@ -159,11 +159,22 @@ pub(crate) fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
     })
 }
 
+/// Every number finite and within ±[`crate::limits::COORD_MAX`]: larger ones overflow
+/// squared distances (1e308 gives an infinite error that compares as "within bounds").
 fn check_finite(what: impl FnOnce() -> String, xs: &[f64]) -> Result<()> {
-    if xs.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(ExportError::invalid(what(), "non-finite number"))
+    match xs
+        .iter()
+        .find(|x| !(x.is_finite() && x.abs() <= crate::limits::COORD_MAX))
+    {
+        None => Ok(()),
+        Some(x) => Err(ExportError::invalid(
+            what(),
+            format!(
+                "{} is not allowed: numbers must be finite and within ±{}",
+                crate::text::num(*x),
+                crate::text::num(crate::limits::COORD_MAX)
+            ),
+        )),
     }
 }
 
@@ -214,12 +225,7 @@ pub fn validate_pattern(p: &Pattern) -> Result<()> {
         }
     }
     for (j, fr) in p.frames.iter().enumerate() {
-        if !fr.t.is_finite() {
-            return Err(ExportError::invalid(
-                format!("pattern.frames[{j}].t"),
-                "non-finite number",
-            ));
-        }
+        check_finite(|| format!("pattern.frames[{j}].t"), &[fr.t])?;
         if fr.coords.len() != n {
             return Err(ExportError::invalid(
                 format!("pattern.frames[{j}].coords"),
@@ -277,10 +283,14 @@ pub fn validate_meta(meta: &DesignMeta, p: &Pattern) -> Result<()> {
     if let Some(c) = &meta.obstacle {
         check_finite(|| "meta.obstacle.a".into(), &c.a)?;
         check_finite(|| "meta.obstacle.b".into(), &c.b)?;
-        if !(c.radius.is_finite() && c.radius > 0.0) {
+        if !(c.radius.is_finite() && c.radius > 0.0 && c.radius <= crate::limits::COORD_MAX) {
             return Err(ExportError::invalid(
                 "meta.obstacle.radius",
-                format!("{} is not allowed; the radius must be > 0", c.radius),
+                format!(
+                    "{} is not allowed; the radius must be > 0 and at most {}",
+                    crate::text::num(c.radius),
+                    crate::text::num(crate::limits::COORD_MAX)
+                ),
             ));
         }
         if crate::geom::norm(crate::geom::sub(c.b, c.a)) == 0.0 {
@@ -397,6 +407,46 @@ pub fn picked_frames(n: usize, count: usize) -> Vec<usize> {
     out
 }
 
+impl Files {
+    /// Every path, in writing order.
+    pub fn all(&self) -> Vec<PathBuf> {
+        let mut v = vec![
+            self.fold.clone(),
+            self.svg.clone(),
+            self.obj.clone(),
+            self.stl.clone(),
+        ];
+        for (png, svg) in self.pngs.iter().zip(&self.folded_svgs) {
+            v.push(png.clone());
+            v.push(svg.clone());
+        }
+        v.extend(self.gif.clone());
+        v
+    }
+}
+
+/// The files [`write_all`] writes for `pattern` with `opts` into `out_dir` (so a caller can
+/// list them before they exist).
+pub fn planned_files(out_dir: &Path, pattern: &Pattern, opts: &ExportOptions) -> Files {
+    let path = |ext: &str| out_dir.join(format!("{}.{ext}", opts.name));
+    let picked = picked_frames(pattern.frames.len(), opts.picture_states);
+    Files {
+        fold: path("fold"),
+        svg: path("svg"),
+        obj: path("obj"),
+        stl: path("stl"),
+        pngs: picked
+            .iter()
+            .map(|k| out_dir.join(format!("{}_state{k}.png", opts.name)))
+            .collect(),
+        folded_svgs: picked
+            .iter()
+            .map(|k| out_dir.join(format!("{}_state{k}.svg", opts.name)))
+            .collect(),
+        gif: (opts.gif && !pattern.frames.is_empty()).then(|| path("gif")),
+    }
+}
+
 /// Write every file for one design into `out_dir` (created if missing): FOLD, crease
 /// pattern SVG, OBJ and STL of the final state, PNG and SVG pictures of a few states,
 /// and the GIF animation. With `meta.second_arm`, pictures and meshes show both arms.
@@ -418,14 +468,7 @@ pub fn write_all(
         path: out_dir.to_path_buf(),
         source,
     })?;
-    let path = |ext: &str| out_dir.join(format!("{}.{ext}", opts.name));
-    let mut files = Files {
-        fold: path("fold"),
-        svg: path("svg"),
-        obj: path("obj"),
-        stl: path("stl"),
-        ..Files::default()
-    };
+    let files = planned_files(out_dir, pattern, opts);
     write_file(
         &files.fold,
         fold::to_fold_string(pattern, meta, opts.fold_spec)?,
@@ -452,21 +495,16 @@ pub fn write_all(
     write_file(&files.stl, stl)?;
 
     let scene = render::Scene::new(pattern, meta, opts.camera)?;
-    for k in picked_frames(pattern.frames.len(), opts.picture_states) {
-        let png = out_dir.join(format!("{}_state{k}.png", opts.name));
-        write_file(&png, scene.png(Some(k), opts.image_size)?)?;
-        files.pngs.push(png);
-        let fsvg = out_dir.join(format!("{}_state{k}.svg", opts.name));
-        write_file(&fsvg, scene.svg(Some(k), opts.image_size))?;
-        files.folded_svgs.push(fsvg);
+    let picked = picked_frames(pattern.frames.len(), opts.picture_states);
+    for ((k, png), fsvg) in picked.iter().zip(&files.pngs).zip(&files.folded_svgs) {
+        write_file(png, scene.png(Some(*k), opts.image_size)?)?;
+        write_file(fsvg, scene.svg(Some(*k), opts.image_size))?;
     }
-    if opts.gif && !pattern.frames.is_empty() {
-        let gif = path("gif");
+    if let Some(gif) = &files.gif {
         write_file(
-            &gif,
+            gif,
             scene.gif(opts.image_size, opts.gif_delay_cs, opts.gif_max_frames)?,
         )?;
-        files.gif = Some(gif);
     }
     Ok(files)
 }
@@ -491,21 +529,27 @@ pub struct DesignFile {
 impl DesignFile {
     /// Read and validate a design JSON file.
     pub fn read(path: &Path) -> Result<DesignFile> {
-        let text = std::fs::read_to_string(path).map_err(|source| ExportError::Io {
+        let text = crate::limits::read_text(path).map_err(|source| ExportError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        let d: DesignFile = serde_json::from_str(&text).map_err(|e| {
+        DesignFile::parse(&text, &path.display().to_string())
+    }
+
+    /// Parse and validate design JSON text; `source` names it in messages.
+    pub fn parse(text: &str, source: &str) -> Result<DesignFile> {
+        let d: DesignFile = serde_json::from_str(text).map_err(|e| {
             ExportError::invalid(
-                path.display().to_string(),
+                source,
                 format!(
-                    "not a design file ({e}); expected {{\"pattern\": {{vertices, edges, faces, frames}}, \"meta\": {{task, …}}}}"
+                    "not a design file ({}); expected {{\"pattern\": {{vertices, edges, faces, frames}}, \"meta\": {{task, …}}}}",
+                    crate::text::excerpt(&e.to_string(), 200)
                 ),
             )
         })?;
         validate_pattern(&d.pattern)
             .and_then(|()| validate_meta(&d.meta, &d.pattern))
-            .map_err(|e| ExportError::invalid(path.display().to_string(), e.to_string()))?;
+            .map_err(|e| ExportError::invalid(source, e.to_string()))?;
         Ok(d)
     }
 }

@@ -127,9 +127,7 @@ pub struct Enumeration {
 
 /// The search tree grew past the graph budget given to [`Enumeration::run_limited`].
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "the search tree exceeded {limit} graphs at level {level} (N_max = {n_max}); switch the isomorphism filter on or lower N_max"
-)]
+#[error("the search tree exceeded {limit} graphs at level {level} (N_max = {n_max})")]
 pub struct TooLarge {
     /// The budget.
     pub limit: usize,
@@ -137,6 +135,76 @@ pub struct TooLarge {
     pub level: usize,
     /// The N_max requested.
     pub n_max: usize,
+}
+
+/// How many graphs an enumeration would generate: counted at smaller N_max as far as
+/// they fit the budget, then extrapolated by the last growth ratio per internal vertex.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GraphEstimate {
+    /// (N_max, graphs generated) for every smaller N_max that fits the budget.
+    pub measured: Vec<(usize, usize)>,
+    /// Growth per internal vertex used to extrapolate.
+    pub ratio: f64,
+    /// The estimate at the requested N_max.
+    pub graphs: f64,
+}
+
+impl GraphEstimate {
+    /// Extrapolate `measured` (N_max, graphs) to `n_max` by the last growth ratio.
+    pub fn extrapolate(measured: Vec<(usize, usize)>, n_max: usize) -> GraphEstimate {
+        let ratio = match measured.as_slice() {
+            [.., (_, a), (_, b)] if *a > 0 && *b > *a => *b as f64 / *a as f64,
+            // Too little to measure: the growth seen on the bundled tasks.
+            _ => 20.0,
+        };
+        let (k, g) = measured.last().copied().unwrap_or((0, 1));
+        GraphEstimate {
+            graphs: g as f64 * ratio.powi(n_max.saturating_sub(k) as i32),
+            measured,
+            ratio,
+        }
+    }
+
+    /// Why an enumeration at `n_max` with `filters` is refused, for the user: the
+    /// estimate, what it would take, what fits, and which switch would help.
+    pub fn refusal(&self, task: &str, n_max: usize, filters: Filters) -> String {
+        use crate::limits::{GRAPH_BYTES, GRAPHS_MAX};
+        let gb = |graphs: f64| graphs * GRAPH_BYTES as f64 / 1e9;
+        let measured: Vec<String> = self
+            .measured
+            .iter()
+            .rev()
+            .take(2)
+            .rev()
+            .map(|(k, g)| format!("{g} at N_max = {k}"))
+            .collect();
+        let mut s = format!(
+            "N_max = {n_max} is too large for task '{task}': about {:.0} graphs, about {:.0} GB in memory (counted: {}; ×{:.1} per internal vertex). One enumeration keeps at most {GRAPHS_MAX} graphs ({:.1} GB).",
+            self.graphs,
+            gb(self.graphs),
+            if measured.is_empty() {
+                "none fits".to_string()
+            } else {
+                measured.join(", ")
+            },
+            self.ratio,
+            gb(GRAPHS_MAX as f64),
+        );
+        let mut helps = Vec::new();
+        if let Some((k, _)) = self.measured.last() {
+            helps.push(format!("lower N_max to {k}"));
+        }
+        if !filters.isomorphism {
+            helps.push("switch the isomorphism filter on (drop --no-iso)".to_string());
+        }
+        if !filters.mirror {
+            helps.push("switch the mirror filter on (drop --no-mirror)".to_string());
+        }
+        if !helps.is_empty() {
+            s.push_str(&format!(" To run: {}.", helps.join(", or ")));
+        }
+        s
+    }
 }
 
 impl Enumeration {
@@ -226,6 +294,30 @@ impl Enumeration {
             filters,
             mirror_applied,
         })
+    }
+
+    /// Enumerate up to `n_max` keeping at most `max_graphs` graphs, or say why not with an
+    /// estimate. The smaller N_max are counted first (together about a twentieth of the
+    /// last): an N_max whose extrapolated size is far beyond the budget is refused without
+    /// being tried, so the refusal costs no more memory than the largest N_max that fits.
+    pub fn run_within(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        max_graphs: usize,
+    ) -> Result<Enumeration, GraphEstimate> {
+        let mut measured = Vec::new();
+        for k in 1..n_max {
+            match Self::run_limited(task, k, filters, max_graphs) {
+                Ok(e) => measured.push((k, e.nodes.len())),
+                Err(_) => return Err(GraphEstimate::extrapolate(measured, n_max)),
+            }
+        }
+        let estimate = GraphEstimate::extrapolate(measured, n_max);
+        if estimate.graphs > 2.0 * max_graphs as f64 {
+            return Err(estimate);
+        }
+        Self::run_limited(task, n_max, filters, max_graphs).map_err(|_| estimate)
     }
 
     /// The generated graph with this rule sequence, if it was generated.

@@ -7,8 +7,11 @@
 //! (both arms for a two-armed task) and against the obstacles, and verified independently
 //! (a verification failure is a bug and is reported loudly). Results stream to
 //! `OUT/alternatives.jsonl` one line per alternative as it finishes, so a killed run
-//! loses nothing and `--resume` skips what is done.
+//! loses nothing and `--resume` skips what is done. [`output`] decides where a run may
+//! write, what it may delete (only what an earlier run listed in its manifest) and when
+//! its records may be reused.
 
+pub mod output;
 mod progress;
 mod record;
 mod report;

@@ -1,5 +1,6 @@
 //! Running a search: scheduling, streaming, resuming, summarizing, exporting.
 
+use super::output::{self, OutputDir, RECORDS, RunSettings, SETTINGS};
 use super::progress::Progress;
 use super::record::{AlternativeRecord, Summary, Timings, level_distribution};
 use super::report::{report_design, report_input, task_facts};
@@ -9,6 +10,7 @@ use crate::compile::Options as CompileOptions;
 use crate::cpu_time::Stopwatch;
 use crate::export::{self, DesignMeta, ExportOptions};
 use crate::grammar::{CreaseGraph, Enumeration, Filters};
+use crate::limits;
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
 use crate::model::{Model, ModelError};
@@ -18,10 +20,9 @@ use crate::task::Task;
 use rayon::prelude::*;
 use serde_json::json;
 use std::collections::{BTreeMap, HashMap};
-use std::fs::{self, File, OpenOptions};
-use std::io::{BufRead, BufReader, Write};
-use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex, OnceLock};
+use std::io::Write;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// Settings of a search.
@@ -35,8 +36,13 @@ pub struct SearchOptions {
     pub starts: usize,
     /// Seed of the starting points.
     pub seed: u64,
-    /// Skip alternatives already in `OUT/alternatives.jsonl`.
+    /// Skip alternatives already in `OUT/alternatives.jsonl` (only of a run of the same
+    /// settings).
     pub resume: bool,
+    /// Use a directory that is not an earlier run of the same settings: replace a
+    /// foldsynth run of other settings (deleting only its listed files), or write into a
+    /// foreign directory (deleting nothing).
+    pub force: bool,
     /// Override the task's N_max.
     pub n_max: Option<usize>,
     /// States of the verification sweep over [0, t_max].
@@ -57,6 +63,7 @@ impl Default for SearchOptions {
             starts: 16,
             seed: 0,
             resume: false,
+            force: false,
             n_max: None,
             sweep: 181,
             export: true,
@@ -84,19 +91,15 @@ pub enum SearchError {
         /// The error.
         source: std::io::Error,
     },
+    /// The output directory cannot be used (see [`super::output`]).
+    #[error(transparent)]
+    Output(#[from] output::OutputError),
     /// A model could not be built.
     #[error(transparent)]
     Model(#[from] ModelError),
     /// Export failed.
     #[error("export: {0}")]
     Export(String),
-}
-
-fn io(path: &Path) -> impl FnOnce(std::io::Error) -> SearchError + '_ {
-    move |source| SearchError::Io {
-        path: path.display().to_string(),
-        source,
-    }
 }
 
 /// One design alternative: a graph, a gripping candidate and a mode assignment.
@@ -147,8 +150,17 @@ pub struct Prepared {
     pub compiled: CompiledModel,
 }
 
-/// A lazily compiled model (or why it failed) and the CPU seconds it took.
-type CompiledSlot = (Result<Arc<Prepared>, String>, f64);
+/// The compiled model of one (graph, candidate) while its alternatives are evaluated.
+struct Slot {
+    /// The model, or why it failed; `None` before the first alternative and after the last.
+    model: Option<Result<Arc<Prepared>, String>>,
+    /// CPU seconds spent compiling (the compiling thread's clock).
+    seconds: f64,
+    /// Alternatives of this slot still to evaluate.
+    remaining: usize,
+    /// Whether a failure was reported (once per slot).
+    reported: bool,
+}
 
 /// Build and compile the model of one graph and candidate.
 pub fn prepare(graph: &CreaseGraph, task: &Task, candidate: usize) -> Result<Prepared, String> {
@@ -316,22 +328,6 @@ fn evaluate(
     rec
 }
 
-/// Records already written by an earlier run (a torn last line from a kill is skipped).
-fn read_records(path: &Path) -> Result<Vec<AlternativeRecord>, SearchError> {
-    if !path.exists() {
-        return Ok(Vec::new());
-    }
-    let file = File::open(path).map_err(io(path))?;
-    let mut out = Vec::new();
-    for line in BufReader::new(file).lines() {
-        let line = line.map_err(io(path))?;
-        if let Ok(r) = serde_json::from_str::<AlternativeRecord>(&line) {
-            out.push(r);
-        }
-    }
-    Ok(out)
-}
-
 /// Run the search of `task` and write everything under `opts.out`.
 pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     let start = Instant::now();
@@ -354,14 +350,22 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         return Err(terr("no [motion]: a search needs t_max"));
     }
     let n_max = opts.n_max.unwrap_or(task.n_max);
-    if n_max == 0 {
-        return Err(terr("N_max = 0: there is nothing to extend"));
+    // Every count is checked before anything is allocated.
+    let counts = [
+        ("N_max", n_max as u64, 1, limits::N_MAX as u64),
+        ("starts", opts.starts as u64, 1, limits::STARTS_MAX as u64),
+        ("sweep", opts.sweep as u64, 2, limits::SWEEP_MAX as u64),
+        ("jobs", opts.jobs as u64, 0, limits::JOBS_MAX as u64),
+    ];
+    for (what, value, min, max) in counts {
+        limits::check_count(what, value, min, max).map_err(|m| terr(&m))?;
     }
 
     let progress = Progress::new(opts.progress);
     progress.phase("enumerate graphs", "graphs", None);
     let t0 = Instant::now();
-    let enumeration = Enumeration::run(task, n_max, Filters::all());
+    let enumeration = Enumeration::run_within(task, n_max, Filters::all(), limits::GRAPHS_MAX)
+        .map_err(|est| terr(&est.refusal(&task.name, n_max, Filters::all())))?;
     let graphs: Vec<&CreaseGraph> = enumeration.meaningful().map(|n| &n.graph).collect();
     let enumerate_s = t0.elapsed().as_secs_f64();
     progress.inc(graphs.len() as u64);
@@ -370,6 +374,19 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         enumeration.nodes.len(),
         graphs.len()
     ));
+    if graphs.is_empty() {
+        return Err(terr(&format!(
+            "G0 generates no meaningful graph up to N_max = {n_max} (see `foldsynth enumerate`): there is nothing to optimize"
+        )));
+    }
+    let count = enumeration.alternatives();
+    if count > limits::ALTERNATIVES_MAX {
+        return Err(terr(&format!(
+            "N_max = {n_max} gives {count} design alternatives ({} graphs); one search evaluates at most {} (each takes tens of milliseconds and keeps a record in memory). Lower N_max.",
+            graphs.len(),
+            limits::ALTERNATIVES_MAX
+        )));
+    }
 
     let mut alternatives = Vec::new();
     for (g, graph) in graphs.iter().enumerate() {
@@ -387,67 +404,66 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         }
     }
 
-    fs::create_dir_all(&opts.out).map_err(io(&opts.out))?;
-    // The settings that decide the results: a resumed run must use the same ones, or its
-    // records would mix two searches.
-    let settings_path = opts.out.join("settings.json");
-    let settings = json!({
-        "task": task.name, "n_max": n_max, "starts": opts.starts, "seed": opts.seed,
-        "sweep": opts.sweep, "foldsynth": env!("CARGO_PKG_VERSION"),
-    });
-    if opts.resume
-        && let Ok(text) = fs::read_to_string(&settings_path)
-        && let Ok(old) = serde_json::from_str::<serde_json::Value>(&text)
-        && old != settings
-    {
-        return Err(terr(&format!(
-            "--resume: {} was written with other settings ({old}); resume with those, or start afresh without --resume",
-            settings_path.display()
-        )));
-    }
-    fs::write(
-        &settings_path,
-        serde_json::to_string_pretty(&settings).expect("settings serialize"),
-    )
-    .map_err(io(&settings_path))?;
-    let jsonl = opts.out.join("alternatives.jsonl");
-    let mut done: Vec<AlternativeRecord> = if opts.resume {
-        read_records(&jsonl)?
-    } else {
-        Vec::new()
+    // The settings that decide the results: the output directory holds only runs of
+    // these settings (see `output`).
+    let settings = RunSettings {
+        task: task.name.clone(),
+        task_digest: task.digest.clone(),
+        n_max,
+        starts: opts.starts,
+        seed: opts.seed,
+        sweep: opts.sweep,
+        foldsynth: env!("CARGO_PKG_VERSION").into(),
     };
+    let opened = OutputDir::open(&opts.out, &settings, opts.resume, opts.force)?;
+    for note in &opened.notes {
+        eprintln!("note: {note}");
+    }
+    let out = opened.dir;
+    out.write(
+        SETTINGS,
+        serde_json::to_string_pretty(&settings).unwrap_or_default() + "\n",
+    )?;
     let wanted: HashMap<String, usize> = alternatives
         .iter()
         .enumerate()
         .map(|(i, a)| (a.key(), i))
         .collect();
-    done.retain(|r| wanted.contains_key(&r.key));
+    let (done, resume) = if opened.resume {
+        let path = out.path(RECORDS);
+        let (done, report) = output::read_records(&path, &|k| wanted.contains_key(k))?;
+        eprintln!("{}", report.text(&path));
+        (done, Some(report))
+    } else {
+        (Vec::new(), None)
+    };
     let finished: std::collections::HashSet<String> = done.iter().map(|r| r.key.clone()).collect();
     let todo: Vec<&Alternative> = alternatives
         .iter()
         .filter(|a| !finished.contains(&a.key()))
         .collect();
     // Rewrite the file with the kept records, then append as alternatives finish.
-    {
-        let mut f = File::create(&jsonl).map_err(io(&jsonl))?;
-        for r in &done {
-            writeln!(
-                f,
-                "{}",
-                serde_json::to_string(r).expect("records serialize")
-            )
-            .map_err(io(&jsonl))?;
-        }
-    }
-    let writer = Mutex::new(
-        OpenOptions::new()
-            .append(true)
-            .open(&jsonl)
-            .map_err(io(&jsonl))?,
-    );
+    let (_, records_file) = output::write_records(&out, &done)?;
+    let writer = Mutex::new(records_file);
+    let write_error: Mutex<Option<std::io::Error>> = Mutex::new(None);
 
-    let cache: Vec<OnceLock<CompiledSlot>> =
-        (0..graphs.len() * 3).map(|_| OnceLock::new()).collect();
+    // One model per (graph, candidate), compiled by the first worker that needs it and
+    // dropped after its last alternative: memory stays bounded by the models in flight.
+    let mut pending = vec![0usize; graphs.len() * 3];
+    for a in &todo {
+        pending[a.graph * 3 + a.candidate] += 1;
+    }
+    let cache: Vec<Mutex<Slot>> = pending
+        .into_iter()
+        .map(|remaining| {
+            Mutex::new(Slot {
+                model: None,
+                seconds: 0.0,
+                remaining,
+                reported: false,
+            })
+        })
+        .collect();
     progress.phase(
         "compile + optimize + check",
         "alternatives",
@@ -461,28 +477,57 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         todo.par_iter()
             .filter_map(|alt| {
                 let slot = &cache[alt.graph * 3 + alt.candidate];
-                let (prepared, _) = slot.get_or_init(|| {
-                    let t = Stopwatch::start();
-                    let p = prepare(graphs[alt.graph], task, alt.candidate).map(Arc::new);
-                    (p, t.cpu_ms() / 1e3)
-                });
+                let (prepared, first_failure) = {
+                    // Held while compiling: the other workers of this slot wait for it.
+                    let mut s = slot.lock().unwrap_or_else(|e| e.into_inner());
+                    if s.model.is_none() {
+                        let t = Stopwatch::start();
+                        s.model =
+                            Some(prepare(graphs[alt.graph], task, alt.candidate).map(Arc::new));
+                        s.seconds += t.cpu_ms() / 1e3;
+                    }
+                    let m = s
+                        .model
+                        .clone()
+                        .unwrap_or_else(|| Err("not compiled".into()));
+                    let first = m.is_err() && !std::mem::replace(&mut s.reported, true);
+                    (m, first)
+                };
+                let release = || {
+                    let mut s = slot.lock().unwrap_or_else(|e| e.into_inner());
+                    s.remaining = s.remaining.saturating_sub(1);
+                    if s.remaining == 0 {
+                        // Keep a failure (cheap, and said once); drop the native code.
+                        if matches!(s.model, Some(Ok(_))) {
+                            s.model = None;
+                        }
+                    }
+                };
                 let prepared = match prepared {
-                    Ok(p) => p.clone(),
+                    Ok(p) => p,
                     Err(e) => {
-                        eprintln!(
-                            "error: {} (candidate {}): {e}",
-                            alt.sequence,
-                            alt.candidate + 1
-                        );
+                        if first_failure {
+                            eprintln!(
+                                "error: {} (candidate {}): {e}",
+                                alt.sequence,
+                                alt.candidate + 1
+                            );
+                        }
+                        release();
                         progress.inc(1);
                         return None;
                     }
                 };
                 let rec = evaluate(task, &prepared, alt, graphs[alt.graph], opts);
-                let line = serde_json::to_string(&rec).expect("records serialize");
+                release();
+                let line = serde_json::to_string(&rec).unwrap_or_default();
                 if let Ok(mut w) = writer.lock() {
                     // Each line is flushed as it is written: a kill loses at most this one.
-                    let _ = writeln!(w, "{line}").and_then(|_| w.flush());
+                    if let Err(e) = writeln!(w, "{line}").and_then(|_| w.flush())
+                        && let Ok(mut first) = write_error.lock()
+                    {
+                        first.get_or_insert(e);
+                    }
                 }
                 progress.inc(1);
                 Some(rec)
@@ -490,18 +535,30 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
             .collect()
     });
     progress.finish_phase();
+    if let Some(e) = write_error.into_inner().ok().flatten() {
+        // A record that is not on disk would be lost to --resume: stop here.
+        return Err(SearchError::Io {
+            path: out.path(RECORDS).display().to_string(),
+            source: e,
+        });
+    }
 
     let mut records = done;
     records.extend(new);
     let order: HashMap<String, usize> = wanted;
     records.sort_by_key(|r| order.get(&r.key).copied().unwrap_or(usize::MAX));
 
-    let compile_s: f64 = cache.iter().filter_map(|c| c.get().map(|(_, s)| *s)).sum();
+    // `+ 0.0`: an empty f64 sum is −0.0, which would print as "-0.00 s".
+    let compile_s: f64 = cache
+        .iter()
+        .map(|c| c.lock().map_or(0.0, |s| s.seconds))
+        .sum::<f64>()
+        + 0.0;
     let mut timings = Timings {
         enumerate_s,
         compile_s,
-        optimize_s: records.iter().map(|r| r.optimize_ms).sum::<f64>() / 1e3,
-        check_s: records.iter().map(|r| r.check_ms).sum::<f64>() / 1e3,
+        optimize_s: records.iter().map(|r| r.optimize_ms).sum::<f64>() / 1e3 + 0.0,
+        check_s: records.iter().map(|r| r.check_ms).sum::<f64>() / 1e3 + 0.0,
         export_s: 0.0,
         total_s: 0.0,
         cpu_s: 0.0,
@@ -542,7 +599,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         levels: level_distribution(&records),
         settings: json!({
             "starts": opts.starts, "seed": opts.seed, "jobs": pool.current_num_threads(),
-            "sweep": opts.sweep, "resumed": finished.len(),
+            "sweep": opts.sweep, "resumed": finished.len(), "resume": resume,
         }),
         designs: feasible.iter().map(|r| r.id()).collect(),
     };
@@ -557,17 +614,16 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         &summary,
         opts,
         &progress,
+        &out,
     )?;
     timings.export_s = t2.elapsed().as_secs_f64();
     timings.total_s = start.elapsed().as_secs_f64();
     timings.cpu_s = crate::cpu_time::process_seconds() - cpu0;
     summary.timings = timings;
-    let path = opts.out.join("summary.json");
-    fs::write(
-        &path,
-        serde_json::to_string_pretty(&summary).expect("summary serializes"),
-    )
-    .map_err(io(&path))?;
+    out.write(
+        "summary.json",
+        serde_json::to_string_pretty(&summary).unwrap_or_default(),
+    )?;
     Ok(summary)
 }
 
@@ -618,6 +674,8 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
 
 /// Write `designs/<id>.json` for every feasible design, with export its files, and the
 /// report (always: its 3D views need only the geometry).
+// The run's parts, each borrowed once; a struct of them would only rename the call.
+#[allow(clippy::too_many_arguments)]
 fn write_designs(
     task: &Task,
     graphs: &[&CreaseGraph],
@@ -626,12 +684,11 @@ fn write_designs(
     summary: &Summary,
     opts: &SearchOptions,
     progress: &Progress,
+    out_dir: &OutputDir,
 ) -> Result<(), SearchError> {
-    let dir = opts.out.join("designs");
-    if dir.exists() {
-        fs::remove_dir_all(&dir).map_err(io(&dir))?;
-    }
-    fs::create_dir_all(&dir).map_err(io(&dir))?;
+    // The earlier run's designs were deleted when the directory was opened (only the
+    // files its manifest lists).
+    out_dir.create_dir("designs")?;
     // Designs are independent: write them in parallel, keep the cards in order.
     progress.phase(
         if opts.export {
@@ -699,12 +756,10 @@ fn write_designs(
                 "pattern": pattern,
                 "meta": meta,
             });
-            let path = dir.join(format!("{id}.json"));
-            fs::write(
-                &path,
-                serde_json::to_string_pretty(&doc).expect("design serializes"),
-            )
-            .map_err(io(&path))?;
+            let path = out_dir.write(
+                &format!("designs/{id}.json"),
+                serde_json::to_string_pretty(&doc).unwrap_or_default(),
+            )?;
             if !opts.export {
                 progress.inc(1);
                 return Ok(report_design(
@@ -717,11 +772,13 @@ fn write_designs(
                     None,
                 ));
             }
-            let out = dir.join(&id);
+            let out = out_dir.create_dir(&format!("designs/{id}"))?;
             let eo = ExportOptions {
                 name: id.clone(),
                 ..Default::default()
             };
+            // Listed before they are written, so a kill leaves nothing unlisted.
+            out_dir.register(export::planned_files(&out, &pattern, &eo).all())?;
             let files = export::write_all(&out, &pattern, &meta, &eo)
                 .map_err(|e| SearchError::Export(e.to_string()))?;
             let check = export::verify::verify_file(&files.fold, &Default::default())
@@ -758,9 +815,10 @@ fn write_designs(
         task_facts(task, opts, summary),
         cards,
     );
-    let path = export::report::write_report(&opts.out, &input)
+    out_dir.register([out_dir.path("report.html")])?;
+    let path = export::report::write_report(out_dir.root(), &input)
         .map_err(|e| SearchError::Export(e.to_string()))?;
-    let bytes = fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
     progress.finish_phase_with(&format!("{} ({bytes} bytes)", path.display()));
     Ok(())
 }

@@ -577,7 +577,9 @@ impl CrossvalReport {
     /// error bound.
     pub fn agrees(&self, gamma_tol: f64, position_tol: f64) -> bool {
         self.gamma <= gamma_tol
-            && self.final_position_error.is_some()
+            && self.max_position_error.is_finite()
+            && self.drive_error.is_finite()
+            && self.final_position_error.is_some_and(f64::is_finite)
             && self
                 .states
                 .iter()
@@ -668,22 +670,16 @@ fn compare(
             sim.steps[j - 1].t
         };
         let frame = frame_at(t);
-        let err = frame.map(|f| {
-            x.iter()
-                .zip(&f.coords)
-                .map(|(a, b)| geom::dist(*a, *b))
-                .fold(0.0, f64::max)
-        });
+        // NaN-propagating maxima: a NaN position must fail the comparison, not vanish.
+        let err = frame
+            .map(|f| geom::max_or_nan(x.iter().zip(&f.coords).map(|(a, b)| geom::dist(*a, *b))));
         if let Some(f) = frame {
-            let d = prescribed
-                .iter()
-                .map(|&v| geom::dist(x[v], f.coords[v]))
-                .fold(0.0, f64::max);
+            let d = geom::max_or_nan(prescribed.iter().map(|&v| geom::dist(x[v], f.coords[v])));
             if j == 0 {
                 start_gap = err;
             } else {
-                drive_err = drive_err.max(d);
-                max_err = max_err.max(err.unwrap_or(0.0));
+                drive_err = geom::max_or_nan([drive_err, d]);
+                max_err = geom::max_or_nan([max_err, err.unwrap_or(0.0)]);
                 compared += 1;
             }
         }

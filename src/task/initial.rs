@@ -113,10 +113,7 @@ pub(crate) fn build(
                 ),
             ));
         }
-        let xy = [
-            cx.num(&format!("{}.xy[0]", vf(i)), &v.xy[0])?,
-            cx.num(&format!("{}.xy[1]", vf(i)), &v.xy[1])?,
-        ];
+        let xy = cx.point::<2>(&format!("{}.xy", vf(i)), &v.xy)?;
         vertices.push(InitialVertex {
             id: v.id.clone(),
             xy,

@@ -59,8 +59,12 @@ pub struct TaskError {
 /// A validated design task.
 #[derive(Clone, Debug)]
 pub struct Task {
-    /// The task's name (defaults to the file stem).
+    /// The task's name (defaults to the file stem): at most [`crate::limits::NAME_MAX`]
+    /// characters, no path separators, no `..`, no control characters.
     pub name: String,
+    /// Digest of the file's text (FNV-1a, 64 bits, hex): a search resumes only the same
+    /// task.
+    pub digest: String,
     /// Free text.
     pub description: Option<String>,
     /// Where it was loaded from, if from a file.
@@ -147,7 +151,7 @@ pub use crate::check::Cylinder;
 
 /// Largest N_max accepted: each extension multiplies the number of graphs by roughly
 /// twenty (with all filters: 101 graphs at N_max = 3, 1,929 at 4, 41,549 at 5).
-pub const N_MAX_LIMIT: usize = 6;
+pub const N_MAX_LIMIT: usize = crate::limits::N_MAX;
 
 // ---------------------------------------------------------------------------------------
 // Raw file format (serde), checked by `Task::from_toml_str`.
@@ -193,7 +197,7 @@ pub(crate) struct RawInitial {
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawVertex {
     pub(crate) id: String,
-    pub(crate) xy: [Number; 2],
+    pub(crate) xy: Vec<Number>,
     #[serde(rename = "type")]
     pub(crate) ty: RawType,
 }
@@ -251,7 +255,7 @@ struct RawObjective {
 #[serde(deny_unknown_fields)]
 struct RawTarget {
     t: Number,
-    point: [Number; 3],
+    point: Vec<Number>,
     weight: Option<Number>,
 }
 
@@ -269,8 +273,8 @@ struct RawCheck {
 #[serde(deny_unknown_fields)]
 struct RawCylinder {
     radius: Number,
-    from: [Number; 3],
-    to: [Number; 3],
+    from: Vec<Number>,
+    to: Vec<Number>,
 }
 
 /// Builds errors for one file.
@@ -287,16 +291,41 @@ impl Ctx<'_> {
         }
     }
 
-    /// A finite number, evaluated.
+    /// A finite number within ±[`crate::limits::COORD_MAX`], evaluated.
     pub(crate) fn num(&self, field: &str, n: &Number) -> Result<f64, TaskError> {
         let v = n.value().map_err(|m| self.err(field, m))?;
         if !v.is_finite() {
             return Err(self.err(field, format!("{n} is not a finite number")));
         }
+        if v.abs() > crate::limits::COORD_MAX {
+            return Err(self.err(
+                field,
+                format!(
+                    "{} is out of range: numbers in a task file lie within ±{} (beyond that, squared distances overflow)",
+                    crate::text::num(v),
+                    crate::text::num(crate::limits::COORD_MAX)
+                ),
+            ));
+        }
         Ok(v)
     }
 
-    fn point<const N: usize>(&self, field: &str, p: &[Number; N]) -> Result<[f64; N], TaskError> {
+    /// Exactly `N` numbers (a point), each checked by [`Ctx::num`].
+    pub(crate) fn point<const N: usize>(
+        &self,
+        field: &str,
+        p: &[Number],
+    ) -> Result<[f64; N], TaskError> {
+        if p.len() != N {
+            return Err(self.err(
+                field,
+                format!(
+                    "{} values given; exactly {N} are needed ({})",
+                    p.len(),
+                    if N == 2 { "x, y" } else { "x, y, z" }
+                ),
+            ));
+        }
         let mut out = [0.0; N];
         for (i, n) in p.iter().enumerate() {
             out[i] = self.num(&format!("{field}[{i}]"), n)?;
@@ -310,7 +339,7 @@ impl Task {
     pub fn load(path: impl AsRef<Path>) -> Result<Task, TaskError> {
         let path = path.as_ref();
         let label = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| TaskError {
+        let text = crate::limits::read_text(path).map_err(|e| TaskError {
             file: label.clone(),
             field: "(file)".into(),
             message: format!("cannot read the task file: {e}"),
@@ -318,9 +347,15 @@ impl Task {
         let mut task = Task::from_toml_str(&text, &label)?;
         task.source = Some(path.to_owned());
         if task.name.is_empty() {
+            // The file stem, cut to the limit (the output directory is made safe from it).
             task.name = path
                 .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
+                .map(|s| {
+                    s.to_string_lossy()
+                        .chars()
+                        .take(crate::limits::NAME_MAX)
+                        .collect()
+                })
                 .unwrap_or_default();
         }
         Ok(task)
@@ -329,7 +364,12 @@ impl Task {
     /// Parse and validate task text; `file` labels the messages.
     pub fn from_toml_str(text: &str, file: &str) -> Result<Task, TaskError> {
         let cx = Ctx { file };
+        if let Some(kind) = crate::text::other_kind(text, "task") {
+            return Err(cx.err("(file)", kind));
+        }
         let raw: RawTask = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
+        let name = raw.name.clone().unwrap_or_default();
+        check_name(&name).map_err(|m| cx.err("name", m))?;
 
         let n_max = raw.grammar.n_max;
         if !(1..=N_MAX_LIMIT as i64).contains(&n_max) {
@@ -344,6 +384,16 @@ impl Task {
             mirror_xz: raw.symmetry.mirror_xz,
         };
         let initial = initial::build(&cx, &raw.initial_graph, symmetry.mirror_xz)?;
+        if !initial
+            .vertices
+            .iter()
+            .any(|v| v.ty == VertexType::Extendable)
+        {
+            return Err(cx.err(
+                "initial_graph.vertices",
+                "no vertex has type = \"extendable\": the grammar extends only extendable (χ) vertices, so this G0 generates no crease pattern",
+            ));
+        }
 
         let motion = match &raw.motion {
             None => None,
@@ -462,11 +512,12 @@ impl Task {
         let check = match &raw.check {
             None => None,
             Some(c) => {
-                if c.states < 2 {
+                let max = crate::limits::STATES_MAX as i64;
+                if !(2..=max).contains(&c.states) {
                     return Err(cx.err(
                         "check.states",
                         format!(
-                            "{} is not allowed: at least 2 states (0 and t_max)",
+                            "{} is not allowed: at least 2 states (0 and t_max), at most {max}",
                             c.states
                         ),
                     ));
@@ -504,7 +555,8 @@ impl Task {
         };
 
         Ok(Task {
-            name: raw.name.unwrap_or_default(),
+            name: name.trim().to_string(),
+            digest: digest(text.as_bytes()),
             description: raw.description,
             source: None,
             initial,
@@ -516,6 +568,37 @@ impl Task {
             check,
         })
     }
+}
+
+/// Why `name` cannot name a task (it names the output directory `out/<name>`).
+fn check_name(name: &str) -> Result<(), String> {
+    let shown = crate::text::excerpt(name, 40);
+    let max = crate::limits::NAME_MAX;
+    if name.chars().count() > max {
+        return Err(format!(
+            "\"{shown}\" is longer than {max} characters (the name becomes a directory name)"
+        ));
+    }
+    if name.contains(['/', '\\']) || name.chars().any(char::is_control) {
+        return Err(format!(
+            "{shown:?}: a task name may not contain path separators or control characters (it becomes the directory out/<name>)"
+        ));
+    }
+    if name.contains("..") || name.trim() == "." {
+        return Err(format!(
+            "{shown:?}: a task name may not contain \"..\" or be \".\" (it becomes the directory out/<name>)"
+        ));
+    }
+    Ok(())
+}
+
+/// FNV-1a (64 bits) of `bytes`, as 16 hex digits: enough to notice an edited file.
+fn digest(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h = (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{h:016x}")
 }
 
 /// A TOML syntax or schema error, located by line and column, with the offending key when
@@ -539,6 +622,6 @@ fn syntax_error(file: &str, text: &str, e: &toml::de::Error) -> TaskError {
     TaskError {
         file: file.to_owned(),
         field,
-        message: format!("{loc}{}", e.message().trim()),
+        message: format!("{loc}{}", crate::text::excerpt(e.message().trim(), 300)),
     }
 }

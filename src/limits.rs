@@ -1,0 +1,131 @@
+//! The limit of every count a user can give, checked before anything is allocated.
+//!
+//! Each limit is far above what a task needs (the thesis's tasks use N_max = 3, 16 states,
+//! 16 starts) and low enough that the run fits in memory and ends: a value beyond it is
+//! refused with a message naming the limit, never attempted. The README's "Limits" table
+//! lists them.
+
+/// Largest N_max (task files and `--n-max`). The graphs grow about twentyfold per
+/// internal vertex; whether a given task fits at a given N_max is estimated before the
+/// enumeration ([`GRAPHS_MAX`]).
+pub const N_MAX: usize = 6;
+/// Most graphs one enumeration keeps in memory (about [`GRAPH_BYTES`] each: 1.5 GB).
+pub const GRAPHS_MAX: usize = 100_000;
+/// Memory per generated graph, measured: the gripper at N_max = 5 keeps 41,549 graphs in
+/// a peak of 622 MB.
+pub const GRAPH_BYTES: u64 = 15_000;
+/// Most design alternatives one search evaluates (graphs × 2^N × 3 candidates; the
+/// gripper has 1,194 at N_max = 3, 28,122 at 4, 711,642 at 5).
+pub const ALTERNATIVES_MAX: u64 = 1_000_000;
+/// Most starting points per alternative (`--starts`).
+pub const STARTS_MAX: usize = 1_000;
+/// Most states of the verification sweep (`--sweep`, `model --sweep`).
+pub const SWEEP_MAX: usize = 10_000;
+/// Most states of the intersection check (`check.states`).
+pub const STATES_MAX: usize = 1_000;
+/// Most samples of `vertex --t A:B:N`.
+pub const SAMPLES_MAX: usize = 100_000;
+/// Most worker threads (`--jobs`).
+pub const JOBS_MAX: usize = 256;
+/// Most folding steps of the bar-and-hinge simulation (`--steps`, `motion.steps`).
+pub const STEPS_MAX: u64 = 100_000;
+/// Most evaluations of `optimize-flasher --evals`.
+pub const EVALS_MAX: u64 = 10_000_000;
+/// Longest task name (it names the output directory).
+pub const NAME_MAX: usize = 64;
+/// Longest timing budget of `bench … --millis`.
+pub const BENCH_MILLIS_MAX: u64 = 60_000;
+/// Largest picture side in pixels (`export --size`).
+pub const IMAGE_SIDE_MAX: u32 = 4096;
+/// Largest magnitude of a coordinate, length or target in task, pattern and design
+/// files: squared distances of larger numbers overflow, and no origami is 10^6 units.
+pub const COORD_MAX: f64 = 1e6;
+/// Largest input file (task, pattern, FOLD, design).
+pub const FILE_BYTES_MAX: u64 = 256 << 20;
+
+/// `value` checked against `min..=max`; the error names what and the limit.
+pub fn check_count(what: &str, value: u64, min: u64, max: u64) -> Result<(), String> {
+    if value < min {
+        Err(format!("{what} {value} is too small: at least {min}"))
+    } else if value > max {
+        Err(format!(
+            "{what} {value} is over the limit of {max} (foldsynth's limits keep every run in bounded memory and time; see the README)"
+        ))
+    } else {
+        Ok(())
+    }
+}
+
+/// A command-line count in `MIN..=MAX` (a clap value parser).
+pub fn count<const MIN: u64, const MAX: u64>(s: &str) -> Result<usize, String> {
+    let v: u64 = s.trim().parse().map_err(|_| {
+        format!(
+            "'{}' is not a whole number (allowed: {MIN} to {MAX})",
+            crate::text::excerpt(s, 40)
+        )
+    })?;
+    if v < MIN || v > MAX {
+        return Err(format!(
+            "{v} is out of range: allowed {MIN} to {MAX} (see the README's limits)"
+        ));
+    }
+    usize::try_from(v).map_err(|_| format!("{v} does not fit this machine's word size"))
+}
+
+/// Read a file of at most [`FILE_BYTES_MAX`] bytes as text.
+pub fn read_text(path: &std::path::Path) -> std::io::Result<String> {
+    let meta = std::fs::metadata(path)?;
+    if meta.is_dir() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "is a directory, not a file",
+        ));
+    }
+    if meta.len() > FILE_BYTES_MAX {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!(
+                "{} bytes: larger than foldsynth reads ({FILE_BYTES_MAX} bytes)",
+                meta.len()
+            ),
+        ));
+    }
+    std::fs::read_to_string(path)
+}
+
+/// Deepest nesting of parentheses in an expression or a vertex notation: recursive
+/// descent and evaluation need stack in proportion.
+pub const EXPR_DEPTH_MAX: usize = 64;
+/// Most operators and parentheses in one expression or vertex notation: the expression
+/// tree (evaluated and dropped recursively) stays shallow.
+pub const EXPR_OPS_MAX: usize = 1000;
+
+/// Check the size of an expression before parsing it: `Err((character position,
+/// message))` at the first excess.
+pub fn check_expression(text: &str) -> Result<(), (usize, String)> {
+    let (mut depth, mut ops) = (0usize, 0usize);
+    for (i, c) in text.chars().enumerate() {
+        match c {
+            '(' => {
+                depth += 1;
+                ops += 1;
+                if depth > EXPR_DEPTH_MAX {
+                    return Err((
+                        i,
+                        format!("parentheses nested deeper than {EXPR_DEPTH_MAX} levels"),
+                    ));
+                }
+            }
+            ')' => depth = depth.saturating_sub(1),
+            '+' | '-' | '*' | '/' | '^' => ops += 1,
+            _ => {}
+        }
+        if ops > EXPR_OPS_MAX {
+            return Err((
+                i,
+                format!("more than {EXPR_OPS_MAX} operators and parentheses"),
+            ));
+        }
+    }
+    Ok(())
+}
