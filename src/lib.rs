@@ -11,6 +11,7 @@
 pub mod check;
 pub mod cli;
 pub mod compile;
+pub mod cpu_time;
 pub mod export;
 pub mod expr;
 pub mod fuzz;
@@ -25,3 +26,4 @@ pub mod search;
 pub mod simulate;
 pub mod task;
 pub mod text;
+pub mod trig;

@@ -5,6 +5,7 @@
 
 use crate::compile::vertex::{self, VertexModel};
 use crate::compile::{Dual, Options, compile};
+use crate::cpu_time::Stopwatch;
 use crate::expr::Tape;
 use crate::geom::max_or_nan;
 use crate::kinematics::VertexSpec;
@@ -86,20 +87,25 @@ pub struct VertexBenchArgs {
     pub peer_script: Option<PathBuf>,
 }
 
-/// Median nanoseconds per call of `f`, over batches filling about `budget`.
+/// Median nanoseconds per call of `f`, over batches filling about `budget`: CPU time of
+/// this thread per batch (where the platform has a thread clock), so time the process
+/// spends waiting for a core on a busy machine does not count.
 pub(crate) fn time_ns(budget: Duration, mut f: impl FnMut()) -> f64 {
-    // Calibrate: how many calls take ~1/20 of the budget.
-    let target = budget / 20;
-    let mut n = 1usize;
-    loop {
-        let t = Instant::now();
+    let batch = |f: &mut dyn FnMut(), n: usize| {
+        let t = Stopwatch::start();
         for _ in 0..n {
             f();
         }
-        let e = t.elapsed();
-        if e >= target / 4 || n >= 1 << 30 {
-            let per = e.as_secs_f64() / n as f64;
-            n = ((target.as_secs_f64() / per.max(1e-10)) as usize).max(1);
+        t.cpu_ms() * 1e6
+    };
+    // Calibrate: how many calls take ~1/20 of the budget.
+    let target_ns = budget.as_secs_f64() * 1e9 / 20.0;
+    let mut n = 1usize;
+    loop {
+        let e = batch(&mut f, n);
+        if e >= target_ns / 4.0 || n >= 1 << 30 {
+            let per = e / n as f64;
+            n = ((target_ns / per.max(1e-1)) as usize).max(1);
             break;
         }
         n *= 4;
@@ -107,11 +113,7 @@ pub(crate) fn time_ns(budget: Duration, mut f: impl FnMut()) -> f64 {
     let mut samples = Vec::new();
     let start = Instant::now();
     while samples.len() < 5 || (start.elapsed() < budget && samples.len() < 41) {
-        let t = Instant::now();
-        for _ in 0..n {
-            f();
-        }
-        samples.push(t.elapsed().as_secs_f64() * 1e9 / n as f64);
+        samples.push(batch(&mut f, n) / n as f64);
     }
     samples.sort_by(f64::total_cmp);
     samples[samples.len() / 2]

@@ -19,6 +19,4 @@ mod run;
 
 pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
 pub use record::{AlternativeRecord, RankEntry, Summary, Timings, level_distribution};
-pub use run::{
-    Alternative, SearchError, SearchOptions, model_meta, prepare, remeasure, run,
-};
+pub use run::{Alternative, SearchError, SearchOptions, model_meta, prepare, remeasure, run};

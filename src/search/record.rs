@@ -68,9 +68,9 @@ pub struct AlternativeRecord {
     pub starts_run: usize,
     /// Model evaluations spent.
     pub evaluations: usize,
-    /// Milliseconds optimizing.
+    /// Milliseconds optimizing (CPU time of the worker thread).
     pub optimize_ms: f64,
-    /// Milliseconds checking and verifying.
+    /// Milliseconds checking and verifying (CPU time of the worker thread).
     pub check_ms: f64,
     /// For designs of cyclic graphs (r2′) that meet the target: the dense compatibility
     /// sweep and the bar-and-hinge simulation, which decide whether the design folds.
@@ -122,8 +122,9 @@ impl AlternativeRecord {
     }
 }
 
-/// Seconds spent per stage. Compile, optimize and check add up the time of every worker
-/// (CPU seconds); enumerate, export and total are wall time.
+/// Seconds spent per stage. Compile, optimize and check add up the CPU time of the worker
+/// threads that did them (thread CPU clock: waiting for a core does not count);
+/// enumerate, export and total are wall time; `cpu_s` is the whole process's CPU time.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Timings {
     /// Generating and filtering the graphs.
@@ -138,6 +139,9 @@ pub struct Timings {
     pub export_s: f64,
     /// The whole run, wall clock.
     pub total_s: f64,
+    /// CPU seconds of the whole run, every thread (user + system).
+    #[serde(default)]
+    pub cpu_s: f64,
 }
 
 /// Counts per number of rule applications (thesis Fig. 51).

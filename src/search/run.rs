@@ -10,6 +10,7 @@ use crate::check::robustness::{self, RobustnessInput, UnitCreases};
 use crate::check::verify::{Tolerances, verify};
 use crate::check::{CheckError, Checker, Cylinder, MotionSettings, check_states, two_armed};
 use crate::compile::Options as CompileOptions;
+use crate::cpu_time::Stopwatch;
 use crate::export::{self, DesignMeta, ExportOptions};
 use crate::grammar::{CreaseGraph, Enumeration, Filters, Rules};
 use crate::limits;
@@ -166,7 +167,7 @@ pub struct Prepared {
 struct Slot {
     /// The model, or why it failed; `None` before the first alternative and after the last.
     model: Option<Result<Arc<Prepared>, String>>,
-    /// Seconds spent compiling.
+    /// CPU seconds spent compiling (the compiling thread's clock).
     seconds: f64,
     /// Alternatives of this slot still to evaluate.
     remaining: usize,
@@ -246,7 +247,7 @@ fn evaluate(
     let model = &p.model;
     let modes = alt.mode_signs();
     let key = alt.key();
-    let t0 = Instant::now();
+    let t0 = Stopwatch::start();
     let problem = ModelProblem::new(model, &p.compiled, &modes);
     let optimize_opts = optimize::Options {
         starts: opts.starts,
@@ -270,7 +271,7 @@ fn evaluate(
         optimize_opts.feasibility_tol,
         optimize_opts.target,
     );
-    let optimize_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let optimize_ms = t0.cpu_ms();
     let full = model.full_vars(&sol.x);
     let omega = model.omega(&full, &modes);
     let meets = sol.feasible && omega <= model.threshold;
@@ -314,7 +315,7 @@ fn evaluate(
     if !meets {
         return rec;
     }
-    let t1 = Instant::now();
+    let t1 = Stopwatch::start();
     let design = Evaluated::new(&model.plan, full, modes);
     // The judges run on the dense verification sweep, not only on the states the optimizer
     // saw, so an intersection between sampled states cannot hide.
@@ -403,7 +404,7 @@ fn evaluate(
         rec.verification_failed = Some(failed);
     }
     rec.verification = Some(report);
-    rec.check_ms = t1.elapsed().as_secs_f64() * 1e3;
+    rec.check_ms = t1.cpu_ms();
     rec
 }
 
@@ -525,6 +526,7 @@ pub fn remeasure(
 /// Run the search of `task` and write everything under `opts.out`.
 pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     let start = Instant::now();
+    let cpu0 = crate::cpu_time::process_seconds();
     let terr = |m: &str| SearchError::Task {
         task: task.name.clone(),
         message: m.to_string(),
@@ -678,13 +680,12 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
                     // Held while compiling: the other workers of this slot wait for it.
                     let mut s = slot.lock().unwrap_or_else(|e| e.into_inner());
                     if s.model.is_none() {
-                        let t = Instant::now();
-                        s.model =
-                            Some(
+                        let t = Stopwatch::start();
+                        s.model = Some(
                             prepare(graphs[alt.graph], task, alt.candidate, robust_spec.as_ref())
                                 .map(Arc::new),
                         );
-                        s.seconds += t.elapsed().as_secs_f64();
+                        s.seconds += t.cpu_ms() / 1e3;
                     }
                     let m = s
                         .model
@@ -761,6 +762,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         check_s: records.iter().map(|r| r.check_ms).sum::<f64>() / 1e3 + 0.0,
         export_s: 0.0,
         total_s: 0.0,
+        cpu_s: 0.0,
     };
     let mut feasible: Vec<&AlternativeRecord> =
         records.iter().filter(|r| r.feasible_design()).collect();
@@ -851,6 +853,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     )?;
     timings.export_s = t2.elapsed().as_secs_f64();
     timings.total_s = start.elapsed().as_secs_f64();
+    timings.cpu_s = crate::cpu_time::process_seconds() - cpu0;
     summary.timings = timings;
     out.write(
         "summary.json",
