@@ -151,3 +151,60 @@ fn polish_brings_a_nudged_cell_back_to_a_compatible_one() {
         .fold(0.0, f64::max);
     assert!(d < 1e-3, "moved by {d}");
 }
+
+/// The optimizer's Fig. 52b design on the gripper task (`model --graph "2, 3, 4, 8, (9, 14)'"
+/// --candidate 2 --modes down,up,up,up --optimize`, Ω = 1.2e-6): compatible to 5e-13 and an
+/// isometry, but two of its creases fold on through ±π — its facets pass through each
+/// other, so the cycle sweep must fail it. The Miura cell, whose creases stay inside
+/// (−π, π), still passes.
+#[test]
+fn a_crease_folding_through_flat_fails_the_sweep() {
+    let m = model(1);
+    let vars: [(&str, f64); 15] = [
+        ("l_2,3", 1.28668077747507),
+        ("l_2,4", 1.4578067207899132),
+        ("l_3,8", 0.14435439817941612),
+        ("l_8,13", 0.7541491432423296),
+        ("α_10", 0.37331546631203527),
+        ("α_11", 2.824488079368098),
+        ("α_12", 2.561110737651746),
+        ("α_13", 1.9929461460816855),
+        ("α_3", 0.7457671478371456),
+        ("α_4", 2.5789766761829633),
+        ("α_5", 1.2333386493075686),
+        ("α_6", 1.7961054206767704),
+        ("α_7", 0.5628655650496057),
+        ("α_8", 2.9669575201189273),
+        ("α_9", 2.7363488524356057),
+    ];
+    let free: Vec<f64> = m
+        .free
+        .iter()
+        .map(|&i| {
+            let name = &m.plan.variables[i].name;
+            vars.iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, v)| *v)
+                .unwrap_or_else(|| panic!("no value for {name}"))
+        })
+        .collect();
+    let ts = sample_times(m.t_max, 181);
+    let d = Evaluated::new(&m.plan, m.full_vars(&free), vec![-1.0, 1.0, 1.0, 1.0]);
+    let r = verify_cycles(&d, &ts, 1e-12);
+    // Compatible and continuous in wrapped angles: only the new measure sees it.
+    assert!(r.compatibility_max < 1e-9, "{r:?}");
+    assert!(r.position_max < 1e-9, "{r:?}");
+    let (crease, t) = r.through_flat.clone().expect("a crease passes through ±π");
+    assert!(t > 0.0 && t < m.t_max, "{t}");
+    assert!(!r.passes(CYCLE_TOL));
+    assert!(
+        r.failures(CYCLE_TOL).iter().any(|f| f.contains(&crease)),
+        "{:?}",
+        r.failures(CYCLE_TOL)
+    );
+    // The Miura cell over the same sweep: no crease passes ±π.
+    let c = model(0);
+    let miura = Evaluated::new(&c.plan, c.full_vars(&miura_free(&c)), MIURA_MODES.to_vec());
+    let r = verify_cycles(&miura, &ts, 1e-12);
+    assert!(r.through_flat.is_none(), "{r:?}");
+}

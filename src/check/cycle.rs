@@ -19,6 +19,7 @@ use crate::kinematics::wrap_angle;
 use crate::model::geometry::{position, position_on};
 use crate::model::numeric::Evaluated;
 use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
 
 /// Largest compatibility residual (rad) and position disagreement (paper units) of a
 /// passing cyclic design.
@@ -61,6 +62,12 @@ pub struct CycleReport {
     /// other lines), and the pattern moves like an acyclic one.
     #[serde(default)]
     pub shared_fold_max: f64,
+    /// The first crease found folding through ±π (flat-folded and beyond, so its two facets
+    /// pass through each other) between consecutive checked states: the crease as
+    /// "v3–v8" and the t after which it happens. Wrapped angles hide this from the
+    /// compatibility and continuity measures, and the motion is still an isometry.
+    #[serde(default)]
+    pub through_flat: Option<(String, f64)>,
 }
 
 impl CycleReport {
@@ -73,6 +80,7 @@ impl CycleReport {
             && self.compatibility_max <= tol
             && self.position_max <= tol
             && self.jump_max <= JUMP_TOL
+            && self.through_flat.is_none()
     }
 
     /// Whether some sink's straight crease really folds (see
@@ -105,8 +113,20 @@ impl CycleReport {
                 self.jump_max, self.jump_t
             ));
         }
+        if let Some((crease, t)) = &self.through_flat {
+            out.push(format!(
+                "crease {crease} folds through ±π after t = {t:.6}: its facets pass through each other"
+            ));
+        }
         out
     }
+}
+
+/// Whether a fold angle going from `a` to `b` (both in (−π, π]) between two nearby states
+/// passes through ±π: opposite signs on either side of ±π (|a − b| > π), not merely rounding
+/// of an angle that stays at ±π.
+fn passes_flat(a: f64, b: f64) -> bool {
+    a.signum() != b.signum() && (a - b).abs() > PI && (PI - a.abs()) + (PI - b.abs()) > 1e-9
 }
 
 /// Sweep `design` over the states `ts`; `geometry_margin` as in
@@ -124,6 +144,7 @@ pub fn verify_cycles(design: &Evaluated<'_>, ts: &[f64], geometry_margin: f64) -
         jump_max: 0.0,
         jump_t: 0.0,
         shared_fold_max: 0.0,
+        through_flat: None,
     };
     // Fold angles of the previous checked state, from the flat one (all creases at 0; the
     // PTU's own flat state can be degenerate, e.g. a flat-foldable vertex at t = 0, and is
@@ -145,7 +166,17 @@ pub fn verify_cycles(design: &Evaluated<'_>, ts: &[f64], geometry_margin: f64) -
         }
         r.checked_states += 1;
         // Per sweep step, so that unchecked states in between do not count as a jump.
-        for (a, b) in folded.rho.iter().zip(&prev.1) {
+        for (c, (a, b)) in folded.rho.iter().zip(&prev.1).enumerate() {
+            if r.through_flat.is_none() && passes_flat(wrap_angle(*b), wrap_angle(*a)) {
+                let cr = &plan.creases[c];
+                r.through_flat = Some((
+                    format!(
+                        "v{}–v{}",
+                        plan.vertices[cr.tail].name, plan.vertices[cr.head].name
+                    ),
+                    prev.0,
+                ));
+            }
             let d = wrap_angle(a - b).abs() / f64::from(steps.max(1));
             if d > r.jump_max || d.is_nan() {
                 r.jump_max = if d.is_nan() { f64::INFINITY } else { d };
