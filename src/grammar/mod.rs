@@ -75,7 +75,10 @@ mod notation;
 mod rules;
 
 pub use canon::Code;
-pub use enumerate::{Enumeration, Filters, GraphEstimate, LevelCounts, Node, Status, TooLarge};
+pub use enumerate::{
+    DOT_FOOTER, Enumeration, Filters, Generated, LevelCounts, Node, Status, Streamed, dot_header,
+    dot_node,
+};
 pub use graph::{CreaseGraph, FacetBoundary, FacetError};
 pub use notation::{NotationError, Step, format_sequence, parse_sequence};
 pub use rules::{R2Match, RuleError};

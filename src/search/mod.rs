@@ -12,8 +12,14 @@
 //! its records may be reused.
 
 pub mod output;
+pub mod plan;
 mod record;
 mod run;
 
-pub use record::{AlternativeRecord, Summary, Timings, level_distribution};
-pub use run::{Alternative, SearchError, SearchOptions, prepare, run};
+pub use plan::Plan;
+pub use record::{AlternativeRecord, Summary, Tally, Timings, level_distribution};
+pub use run::{
+    Alternative, Evaluation, FailedModel, SHARD_REPORT, SHARD_TASK, SearchError, SearchOptions,
+    ShardReport, Share, check_search, evaluate_units, finish, open_output, plan, prepare, run,
+    run_shard, settings, tally_records,
+};

@@ -128,22 +128,70 @@ pub struct LevelCounts {
 
 /// The distribution of the records over rule applications.
 pub fn level_distribution(records: &[AlternativeRecord]) -> Vec<LevelCounts> {
-    let max = records.iter().map(|r| r.level).max().unwrap_or(0);
-    (1..=max)
-        .map(|level| {
-            let at: Vec<&AlternativeRecord> = records.iter().filter(|r| r.level == level).collect();
-            LevelCounts {
-                level,
-                alternatives: at.len(),
-                meets_target: at.iter().filter(|r| r.meets_target).count(),
-                no_self_intersection: at
-                    .iter()
-                    .filter(|r| r.meets_target && r.self_intersection_free == Some(true))
-                    .count(),
-                no_intersection: at.iter().filter(|r| r.thesis_feasible()).count(),
-            }
-        })
-        .collect()
+    let mut t = Tally::default();
+    for r in records {
+        t.add(r);
+    }
+    t.levels
+}
+
+/// The counts of a summary, added up one record at a time (a search reads its records
+/// file line by line instead of keeping the records).
+#[derive(Clone, Debug, Default)]
+pub struct Tally {
+    /// Records.
+    pub records: usize,
+    /// Meeting the target.
+    pub meets_target: usize,
+    /// … and free of self-intersection.
+    pub no_self_intersection: usize,
+    /// … and clear of obstacles.
+    pub no_intersection: usize,
+    /// … and rigid over the whole motion, verified.
+    pub feasible: usize,
+    /// Meeting the target, rigid at t_max but not over the whole motion.
+    pub rigid_at_tmax_only: usize,
+    /// Verification failures.
+    pub verification_failures: usize,
+    /// Per number of rule applications, from 1.
+    pub levels: Vec<LevelCounts>,
+    /// Milliseconds optimizing, summed.
+    pub optimize_ms: f64,
+    /// Milliseconds checking, summed.
+    pub check_ms: f64,
+}
+
+impl Tally {
+    /// Count one record.
+    pub fn add(&mut self, r: &AlternativeRecord) {
+        let no_self = r.meets_target && r.self_intersection_free == Some(true);
+        self.records += 1;
+        self.meets_target += usize::from(r.meets_target);
+        self.no_self_intersection += usize::from(no_self);
+        self.no_intersection += usize::from(r.thesis_feasible());
+        self.feasible += usize::from(r.feasible_design());
+        self.rigid_at_tmax_only += usize::from(
+            r.meets_target
+                && r.verification
+                    .as_ref()
+                    .is_some_and(|v| v.rigid_at_tmax && !v.rigid_over_motion),
+        );
+        self.verification_failures += usize::from(r.verification_failed == Some(true));
+        self.optimize_ms += r.optimize_ms;
+        self.check_ms += r.check_ms;
+        while self.levels.len() < r.level {
+            self.levels.push(LevelCounts {
+                level: self.levels.len() + 1,
+                ..LevelCounts::default()
+            });
+        }
+        if let Some(l) = r.level.checked_sub(1).and_then(|i| self.levels.get_mut(i)) {
+            l.alternatives += 1;
+            l.meets_target += usize::from(r.meets_target);
+            l.no_self_intersection += usize::from(no_self);
+            l.no_intersection += usize::from(r.thesis_feasible());
+        }
+    }
 }
 
 /// The summary of a search (`OUT/summary.json`).
