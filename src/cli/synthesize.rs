@@ -88,7 +88,7 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
                 task.name,
                 report.units,
                 report.alternatives,
-                100.0 * report.cost / report.total_cost.max(f64::MIN_POSITIVE),
+                100.0 * report.cost as f64 / report.total_cost.max(1) as f64,
                 report.records,
                 if report.failed_models.is_empty() {
                     String::new()

@@ -7,7 +7,7 @@
 //! merge — computes the same one without talking to the others, and all alternatives of
 //! a model land in one shard, which compiles it once.
 
-use std::cmp::{Ordering, Reverse};
+use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use super::DistributeError;
@@ -18,34 +18,16 @@ use crate::task::Task;
 /// The units of each of `count` shards (shard k at index k − 1), each in record order.
 pub fn assign(plan: &Plan, count: usize) -> Vec<Vec<usize>> {
     let mut order: Vec<usize> = (0..plan.units.len()).collect();
-    order.sort_by(|&a, &b| {
-        plan.units[b]
-            .cost
-            .total_cmp(&plan.units[a].cost)
-            .then(a.cmp(&b))
-    });
+    order.sort_by_key(|&u| (Reverse(plan.units[u].cost), u));
     // Least loaded first; equal loads: the lowest shard number.
-    #[derive(PartialEq)]
-    struct Load(f64, usize);
-    impl Eq for Load {}
-    impl PartialOrd for Load {
-        fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-            Some(self.cmp(other))
-        }
-    }
-    impl Ord for Load {
-        fn cmp(&self, other: &Self) -> Ordering {
-            self.0.total_cmp(&other.0).then(self.1.cmp(&other.1))
-        }
-    }
-    let mut heap: BinaryHeap<Reverse<Load>> = (0..count).map(|k| Reverse(Load(0.0, k))).collect();
+    let mut heap: BinaryHeap<Reverse<(u64, usize)>> = (0..count).map(|k| Reverse((0, k))).collect();
     let mut shards = vec![Vec::new(); count];
     for u in order {
-        let Some(Reverse(Load(cost, k))) = heap.pop() else {
+        let Some(Reverse((load, k))) = heap.pop() else {
             break;
         };
         shards[k].push(u);
-        heap.push(Reverse(Load(cost + plan.units[u].cost, k)));
+        heap.push(Reverse((load + plan.units[u].cost, k)));
     }
     for s in &mut shards {
         s.sort_unstable();
@@ -56,16 +38,6 @@ pub fn assign(plan: &Plan, count: usize) -> Vec<Vec<usize>> {
 /// The units of shard `spec`.
 pub fn share(plan: &Plan, spec: ShardSpec) -> Vec<usize> {
     assign(plan, spec.count).swap_remove(spec.index - 1)
-}
-
-/// The units of each of `count` shards dealt by count alone, in record order (the
-/// baseline the cost-balanced deal is compared with in `foldsynth bench`-style
-/// measurements).
-pub fn assign_by_count(plan: &Plan, count: usize) -> Vec<Vec<usize>> {
-    let n = plan.units.len();
-    (0..count)
-        .map(|k| (k * n / count..(k + 1) * n / count).collect())
-        .collect()
 }
 
 /// Run shard `spec` of the search of `task` (`task_text`: the task file it was read

@@ -7,37 +7,33 @@
 //! so a record's place is computed from its key, without a table of all keys: a search
 //! holds one bit per alternative and a few hundred bytes per graph, whatever N_max.
 
-use std::collections::HashMap;
 use std::time::Instant;
 
 use super::run::Alternative;
 use crate::export::plots::{NodeStatus, TreeNode};
-use crate::grammar::{CreaseGraph, Enumeration, Filters, Status, Step};
+use crate::grammar::{CreaseGraph, Enumeration, Filters, Status};
 use crate::task::Task;
 
 /// The report draws the search tree only up to this many generated graphs: the gripper
-/// has 140 at N_max = 3 and 1,847 at 4; beyond some thousands a drawn tree is unreadable
+/// has 101 at N_max = 3 and 1,929 at 4; beyond some thousands a drawn tree is unreadable
 /// (`foldsynth enumerate --tree` writes any size as DOT).
 pub const TREE_NODES_MAX: usize = 5_000;
 
-/// Cost of compiling one model in units of one alternative's optimization and checks,
-/// measured on the gripper at N_max = 4 (see [`Unit::cost`]).
-pub const COMPILE_COST: f64 = 2.0;
+/// Cost of compiling one model in units of one alternative's optimization and checks:
+/// the median ratio over 48 graphs of the gripper at N_max = 4, 4.3 (see [`Unit::cost`]).
+pub const COMPILE_COST: u64 = 4;
 
 /// A meaningful graph of the plan.
 #[derive(Clone, Debug)]
 pub struct PlannedGraph {
-    /// The rule sequence, e.g. `2, 3, (4, 8)`.
+    /// The rule sequence, e.g. `2, 3, (4, 8)` (the graph is rebuilt from it).
     pub sequence: String,
-    /// The same, as steps (to rebuild the graph).
-    steps: Vec<Step>,
     /// Internal vertices N.
     pub n: usize,
     /// Rule applications.
     pub level: usize,
-    /// Creases: the size of its model (every crease adds a facet map, every internal
-    /// vertex a PTU and its constraints).
-    pub creases: usize,
+    /// Constraints ψ the rules added (Eq. 31–35): the size of its optimization problem.
+    pub constraints: usize,
 }
 
 /// One compiled model's share of the search: a graph, a gripping candidate, all 2^N mode
@@ -52,9 +48,11 @@ pub struct Unit {
     pub first: u64,
     /// Alternatives: 2^N.
     pub count: u64,
-    /// Estimated cost: creases × (2^N + [`COMPILE_COST`]). Time per evaluation grows with
-    /// the model's size, and each model is compiled once for its 2^N alternatives.
-    pub cost: f64,
+    /// Estimated cost: ⌊c^1.5⌋ × (2^N + [`COMPILE_COST`]) for c constraints. Measured on
+    /// the gripper at N_max = 4, an alternative's time and its model's compile time both
+    /// grow about as c^1.4 (log–log fits over 48 graphs), and a model is compiled once for
+    /// its 2^N alternatives. Integers, so every machine deals the same shards.
+    pub cost: u64,
 }
 
 /// Where an alternative sits in the plan.
@@ -84,7 +82,16 @@ pub struct Plan {
     pub generated: usize,
     /// Seconds the enumeration took (wall).
     pub enumerate_s: f64,
-    by_sequence: HashMap<String, usize>,
+    /// (hash of the sequence, graph index), sorted: finds a graph by its sequence without
+    /// a second copy of every sequence.
+    by_sequence: Vec<(u64, usize)>,
+}
+
+fn text_hash(s: &str) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::hash::DefaultHasher::new();
+    s.hash(&mut h);
+    h.finish()
 }
 
 impl Plan {
@@ -118,10 +125,9 @@ impl Plan {
             if g.status == Status::Meaningful {
                 graphs.push(PlannedGraph {
                     sequence: g.graph.sequence(),
-                    steps: g.graph.sequence_steps(),
                     n: g.graph.internal_count(),
                     level: g.level,
-                    creases: g.graph.crease_count(),
+                    constraints: g.graph.constraints().len(),
                 });
             }
         });
@@ -135,16 +141,17 @@ impl Plan {
                     candidate,
                     first,
                     count,
-                    cost: pg.creases as f64 * (count as f64 + COMPILE_COST),
+                    cost: (pg.constraints as u64).pow(3).isqrt() * (count + COMPILE_COST),
                 });
                 first += count;
             }
         }
-        let by_sequence = graphs
+        let mut by_sequence: Vec<(u64, usize)> = graphs
             .iter()
             .enumerate()
-            .map(|(i, g)| (g.sequence.clone(), i))
+            .map(|(i, g)| (text_hash(&g.sequence), i))
             .collect();
+        by_sequence.sort_unstable();
         Plan {
             n_max,
             graphs,
@@ -159,13 +166,8 @@ impl Plan {
 
     /// The crease graph of meaningful graph `g`, rebuilt from its rule sequence.
     pub fn graph(&self, task: &Task, g: usize) -> CreaseGraph {
-        let mut graph = CreaseGraph::initial(task);
-        for &step in &self.graphs[g].steps {
-            graph
-                .apply_step(step)
-                .expect("a generated graph's own sequence applies");
-        }
-        graph
+        CreaseGraph::from_sequence(task, &self.graphs[g].sequence)
+            .expect("a generated graph's own sequence applies")
     }
 
     /// The alternative with mode bits `modes` of unit `u`.
@@ -186,7 +188,13 @@ impl Plan {
     pub fn locate(&self, key: &str) -> Option<Place> {
         let mut parts = key.rsplitn(3, '|');
         let (modes, candidate, sequence) = (parts.next()?, parts.next()?, parts.next()?);
-        let g = *self.by_sequence.get(sequence)?;
+        let h = text_hash(sequence);
+        let from = self.by_sequence.partition_point(|&(k, _)| k < h);
+        let g = self.by_sequence[from..]
+            .iter()
+            .take_while(|&&(k, _)| k == h)
+            .map(|&(_, i)| i)
+            .find(|&i| self.graphs[i].sequence == sequence)?;
         let candidate: usize = candidate.parse().ok()?;
         if !(1..=3).contains(&candidate) {
             return None;
@@ -212,7 +220,7 @@ impl Plan {
     }
 
     /// Total estimated cost of the units `units`.
-    pub fn cost(&self, units: &[usize]) -> f64 {
+    pub fn cost(&self, units: &[usize]) -> u64 {
         units.iter().map(|&u| self.units[u].cost).sum()
     }
 }

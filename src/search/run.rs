@@ -375,10 +375,10 @@ pub struct ShardReport {
     /// Records in `alternatives.jsonl` (all of the shard's alternatives but those of
     /// failed models once it is complete).
     pub records: usize,
-    /// Estimated cost of the shard and of the whole search (see `plan::Unit::cost`).
-    pub cost: f64,
+    /// Estimated cost of the shard (see `plan::Unit::cost`).
+    pub cost: u64,
     /// Estimated cost of the whole search.
-    pub total_cost: f64,
+    pub total_cost: u64,
     /// Models that failed (their alternatives have no records).
     pub failed_models: Vec<FailedModel>,
     /// Time per stage; `total_s` is this run's wall time.
@@ -564,18 +564,18 @@ pub fn evaluate_units(
     if let Some(report) = &report {
         eprintln!("{}", report.text(&out.path(RECORDS)));
     }
-    let todo: Vec<(usize, Vec<u32>)> = units
+    // The units with work left; their modes are listed when a worker takes them up.
+    let done = &done;
+    let undone = move |u: usize| {
+        let unit = &plan.units[u];
+        (0..unit.count as u32).filter(move |&m| !done.contains(unit.first + u64::from(m)))
+    };
+    let todo: Vec<usize> = units
         .iter()
-        .filter_map(|&u| {
-            let unit = &plan.units[u];
-            let modes: Vec<u32> = (0..unit.count as u32)
-                .filter(|&m| !done.contains(unit.first + u64::from(m)))
-                .collect();
-            (!modes.is_empty()).then_some((u, modes))
-        })
+        .copied()
+        .filter(|&u| undone(u).next().is_some())
         .collect();
-    let remaining: usize = todo.iter().map(|(_, m)| m.len()).sum();
-    drop(done);
+    let remaining: usize = todo.iter().map(|&u| undone(u).count()).sum();
     let writer = Mutex::new(records_file);
     let write_error: Mutex<Option<std::io::Error>> = Mutex::new(None);
     let compile_s = Mutex::new(0.0f64);
@@ -601,8 +601,9 @@ pub fn evaluate_units(
         })?;
     let lock = |m: &Mutex<f64>| *m.lock().unwrap_or_else(|e| e.into_inner());
     pool.install(|| {
-        todo.par_iter().for_each(|(u, modes)| {
-            let unit = &plan.units[*u];
+        todo.par_iter().for_each(|&u| {
+            let unit = &plan.units[u];
+            let modes: Vec<u32> = undone(u).collect();
             let graph = plan.graph(task, unit.graph);
             let t = Instant::now();
             let prepared = prepare(&graph, task, unit.candidate);
@@ -628,7 +629,7 @@ pub fn evaluate_units(
                 }
             };
             modes.par_iter().for_each(|&m| {
-                let alt = plan.alternative(*u, m);
+                let alt = plan.alternative(u, m);
                 let rec = evaluate(task, &prepared, &alt, &graph, opts);
                 let mut line = serde_json::to_string(&rec).unwrap_or_default();
                 line.push('\n');
