@@ -125,7 +125,7 @@ fn merged_shards_are_the_single_machine_run() {
         assert!(!keys.is_empty(), "shard {} is empty", k + 1);
         for key in keys {
             assert!(union.insert(key.clone()), "{key} in two shards");
-            let model = key.rsplitn(2, '|').nth(1).unwrap().to_string();
+            let model = key.rsplit_once('|').unwrap().0.to_string();
             assert_eq!(
                 *model_shard.entry(model).or_insert(k),
                 k,
@@ -180,10 +180,15 @@ fn an_incomplete_or_foreign_shard_is_named_and_nothing_is_merged() {
     std::fs::remove_file(dirs[1].join("shard.json")).unwrap();
     let r = merge(&dirs, &out, &[]);
     assert_eq!(r.status.code(), Some(2), "{}", err(&r));
-    let missing_key = serde_json::from_str::<Value>(lines[keep]).unwrap()["key"]
-        .as_str()
-        .unwrap()
-        .to_string();
+    let missing: BTreeSet<String> = lines[keep..]
+        .iter()
+        .map(|l| {
+            serde_json::from_str::<Value>(l).unwrap()["key"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
     let e = err(&r);
     assert!(e.contains("shard 2/2"), "{e}");
     assert!(
@@ -194,7 +199,19 @@ fn an_incomplete_or_foreign_shard_is_named_and_nothing_is_merged() {
         )),
         "{e}"
     );
-    assert!(e.contains(&missing_key), "{e}");
+    // The keys it names (in plan order, not the order the file had) are all missing ones.
+    let named = e
+        .split("e.g. ")
+        .nth(1)
+        .unwrap()
+        .split("; resume")
+        .next()
+        .unwrap();
+    let named: Vec<&str> = named.split("; ").filter(|k| *k != "…").collect();
+    assert!(!named.is_empty(), "{e}");
+    for k in named {
+        assert!(missing.contains(k), "{k} is not missing: {e}");
+    }
     assert!(e.contains("--shard 2/2") && e.contains("--resume"), "{e}");
     assert!(!out.exists(), "something was written for a failed merge");
 
@@ -245,6 +262,11 @@ fn an_incomplete_or_foreign_shard_is_named_and_nothing_is_merged() {
         assert!(err(&r).contains(says), "expected '{says}': {}", err(&r));
         assert!(!out2.exists(), "{says}: something was written");
     }
+    // The merged run into a shard's own directory.
+    let r = merge(&dirs, &dirs[0], &["--force"]);
+    assert_eq!(r.status.code(), Some(2));
+    assert!(err(&r).contains("own directory"), "{}", err(&r));
+    assert!(dirs[0].join("shard.json").is_file());
     // Records of another shard in a shard's directory.
     let mixed = root.path().join("mixed");
     std::fs::create_dir_all(&mixed).unwrap();

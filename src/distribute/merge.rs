@@ -310,6 +310,20 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
         .collect::<Result<Vec<_>, _>>()?;
     check_one_search(&shards)?;
     shards.sort_by_key(|s| s.spec.index);
+    // The merged run must not replace a shard it reads.
+    if let Ok(out) = std::fs::canonicalize(&opts.out) {
+        for s in &shards {
+            if std::fs::canonicalize(&s.dir).is_ok_and(|d| d == out) {
+                return Err(DistributeError::input(
+                    &opts.out,
+                    format!(
+                        "is shard {}'s own directory; give the merged run a directory of its own",
+                        s.spec
+                    ),
+                ));
+            }
+        }
+    }
     let (task, _) = read_task(&shards)?;
     let settings = RunSettings {
         shard: None,

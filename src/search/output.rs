@@ -11,7 +11,7 @@
 //!   With `--force` a foldsynth run of other settings is replaced (its listed files
 //!   deleted) and a foreign directory is written into without deleting anything.
 //! - `--resume` reuses `alternatives.jsonl` only when `settings.json` is readable and equal
-//!   to this run's settings; [`read_records`] says how many records it reused and why it
+//!   to this run's settings; [`keep_records`] says how many records it reused and why it
 //!   dropped any.
 
 use std::collections::{BTreeSet, HashSet};
