@@ -1,42 +1,103 @@
-//! `report.html`: every link resolves, and headless Chromium renders the page with no
-//! console errors, no exceptions and every image loaded. The browser is driven over the
-//! DevTools protocol on a pipe (`--remote-debugging-pipe`: NUL-terminated JSON on file
-//! descriptors 3 and 4), so no extra crate is needed. Skips (printing why) when Chromium
-//! is not installed.
+//! `report.html`: one file that carries everything it shows, and works in a real browser.
+//!
+//! Without a browser: the page loads nothing from anywhere (no `src`, no stylesheet links,
+//! no network), its embedded geometry is the design's (positions, the facets' areas,
+//! assignments), its table rows carry the design ids and the robustness margins, and a
+//! search writes it (with `--no-export` too), names it, shows progress off a terminal and
+//! numbers the gripping vertex one way everywhere (the number that, in the FOLD file,
+//! points at the vertex that reaches the target).
+//!
+//! In headless Chromium (`tests/browser/report_check.mjs`, puppeteer-core over the DevTools
+//! protocol), on copies of report.html alone in an empty folder: no console errors and no
+//! requests, the 3D view is drawn, the slider, a mouse drag and play change the picture,
+//! clicking a header sorts the rows by that column, the filters keep exactly the matching
+//! rows, and clicking a row shows that design. Skips with a printed reason where Chromium,
+//! Node.js or `tests/browser/node_modules` is missing, unless `FOLDSYNTH_REQUIRE_BROWSER=1`
+//! (set by `.ci/run`), which turns the skip into a failure. `FOLDSYNTH_CHROMIUM` names
+//! another Chromium binary.
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
+use foldsynth::export::fold::assignments;
 use foldsynth::export::plots::{DistributionPlot, NodeStatus, Series, TreeNode};
 use foldsynth::export::report::{
-    CountRow, ReportDesign, ReportInput, ReportSummary, TimingRow, write_report,
+    CountRow, Fact, ReportDesign, ReportInput, ReportSummary, TimingRow, write_report,
 };
 use foldsynth::export::verify::{VerifyOptions, verify_file};
-use foldsynth::export::{ExportOptions, samples, write_all};
+use foldsynth::export::{DesignMeta, ExportOptions, samples, write_all};
 use serde_json::{Value, json};
 
-fn build_report(out: &Path) -> PathBuf {
-    let mut designs = Vec::new();
-    for (name, (p, m)) in [
-        ("gripper_demo", samples::demo_gripper()),
-        ("arm demo", samples::demo_arm()),
-    ] {
-        let opts = ExportOptions {
-            name: name.into(),
-            image_size: (240, 180),
-            ..ExportOptions::default()
-        };
-        let files = write_all(&out.join("designs").join(name), &p, &m, &opts).unwrap();
-        let verify = Some(verify_file(&files.fold, &VerifyOptions::default()).unwrap());
-        designs.push(ReportDesign {
-            title: format!("{} <{}>", m.task, m.rule_sequence),
-            meta: m,
-            files,
-            verify,
-        });
+fn margin(value: f64, setting: f64, t: f64, at: &str) -> Value {
+    json!({"value": value, "setting": setting, "t": t, "where": at})
+}
+
+/// Three sample designs with different levels, objectives and robustness records. The
+/// scores follow the contract: min over the present margins of value / setting.
+fn sample_designs() -> Vec<ReportDesign> {
+    let (pg, mut mg) = samples::demo_gripper();
+    mg.objective = Some(3e-7);
+    mg.extra.insert("key".into(), json!("2|2|down"));
+    let rob_g = json!({
+        "score": (0.05_f64 / 0.0175).min(0.02 / 0.01).min(0.1 / 0.01),
+        "rigid_margin": margin(0.05, 0.0175, 1.2, "v1"),
+        "self_clearance": margin(0.02, 0.01, 0.5, "facets f1–f3"),
+        "arm_clearance": null,
+        "obstacle_clearance": margin(0.1, 0.01, 1.5, "facet f2 ↔ cylinder 1"),
+        "min_feature": null,
+    });
+    let (pa, mut ma) = samples::demo_arm();
+    ma.objective = Some(1e-3);
+    let rob_a = json!({
+        "score": 0.014 / 0.0175,
+        "rigid_margin": margin(0.014, 0.0175, 0.3, "v2"),
+        "self_clearance": null, "arm_clearance": null, "obstacle_clearance": null, "min_feature": null,
+    });
+    let p4 = samples::degree4(1.1, 1.2, 7);
+    let m4 = DesignMeta {
+        task: "demo <degree 4>".into(),
+        rule_sequence: "2, 3".into(),
+        modes: vec![foldsynth::export::Mode::Up],
+        gripping_vertex: Some(2),
+        objective: Some(5e-9),
+        ..DesignMeta::default()
+    };
+    let design = |id: &str, level, candidate, pattern, meta, robustness| ReportDesign {
+        id: id.into(),
+        level,
+        candidate,
+        pattern,
+        meta,
+        robustness,
+        facts: vec![Fact::new("note", "a \"quoted\" <value>")],
+        design_file: None,
+        files: None,
+        verify: None,
+    };
+    vec![
+        design("d-arm", 2, None, pa, ma, Some(rob_a)),
+        design("d-grip", 1, Some(2), pg, mg, Some(rob_g)),
+        design("d-deg4", 1, Some(1), p4, m4, None),
+    ]
+}
+
+fn build_report(out: &Path, export: bool) -> (PathBuf, ReportInput) {
+    let mut designs = sample_designs();
+    if export {
+        for d in &mut designs {
+            let opts = ExportOptions {
+                name: d.id.clone(),
+                image_size: (120, 90),
+                gif_max_frames: 4,
+                ..ExportOptions::default()
+            };
+            let files =
+                write_all(&out.join("designs").join(&d.id), &d.pattern, &d.meta, &opts).unwrap();
+            d.verify = Some(verify_file(&files.fold, &VerifyOptions::default()).unwrap());
+            d.files = Some(files);
+        }
     }
     let tree = vec![
         TreeNode {
@@ -51,129 +112,347 @@ fn build_report(out: &Path) -> PathBuf {
             parent: Some(0),
             label: "2, 3".into(),
             level: 2,
-            status: NodeStatus::Meaningful,
-        },
-        TreeNode {
-            id: 2,
-            parent: Some(0),
-            label: "2, 4".into(),
-            level: 2,
             status: NodeStatus::Invalid,
-        },
-        TreeNode {
-            id: 3,
-            parent: Some(0),
-            label: "2, 5".into(),
-            level: 2,
-            status: NodeStatus::Mirror,
-        },
-        TreeNode {
-            id: 4,
-            parent: Some(1),
-            label: "2, 3, (4, 8)".into(),
-            level: 3,
-            status: NodeStatus::Isomorphic,
         },
     ];
     let input = ReportInput {
         summary: ReportSummary {
             title: "foldsynth report & test".into(),
             task: "demo".into(),
-            counts: vec![
-                CountRow {
-                    label: "alternatives".into(),
-                    value: 2,
-                    thesis: Some(1170),
-                },
-                CountRow {
-                    label: "meet the target".into(),
-                    value: 2,
-                    thesis: Some(836),
-                },
-            ],
+            counts: vec![CountRow {
+                label: "alternatives".into(),
+                value: 3,
+                thesis: Some(1170),
+            }],
             timings: vec![TimingRow {
                 stage: "export".into(),
                 seconds: 0.25,
             }],
             notes: vec!["seed 1".into()],
         },
+        task: vec![
+            Fact::new("G0 vertices", "v1 at (0, 0); v2 at (1, 0)"),
+            Fact::new("target", "(0, 0, 1) at t = 1.5708"),
+        ],
         tree,
         distribution: Some(DistributionPlot {
             title: "Designs over rule applications".into(),
             x_label: "rule applications".into(),
             y_label: "designs".into(),
-            series: vec![
-                Series {
-                    name: "all".into(),
-                    points: vec![[1.0, 1.0], [2.0, 3.0], [3.0, 1.0]],
-                },
-                Series {
-                    name: "meets target".into(),
-                    points: vec![[1.0, 1.0], [2.0, 2.0], [3.0, 0.0]],
-                },
-            ],
+            series: vec![Series {
+                name: "all".into(),
+                points: vec![[1.0, 1.0], [2.0, 3.0]],
+            }],
         }),
         designs,
     };
-    write_report(out, &input).unwrap()
+    std::fs::create_dir_all(out).unwrap();
+    (write_report(out, &input).unwrap(), input)
 }
 
-/// Every `src="…"` and `href="…"` of the page, decoded.
-fn links(html: &str) -> Vec<String> {
+/// The page without the text of its inline scripts.
+fn markup(html: &str) -> String {
+    let mut out = String::new();
+    let mut rest = html;
+    while let Some(i) = rest.find("<script") {
+        let open_end = i + rest[i..].find('>').unwrap() + 1;
+        out.push_str(&rest[..open_end]);
+        let close = rest[open_end..].find("</script>").unwrap();
+        rest = &rest[open_end + close..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The embedded data (`<script type="application/json" id="foldsynth-data">`).
+fn embedded(html: &str) -> Value {
+    let key = "<script type=\"application/json\" id=\"foldsynth-data\">";
+    let i = html.find(key).unwrap() + key.len();
+    let j = html[i..].find("</script>").unwrap();
+    serde_json::from_str(&html[i..i + j]).unwrap()
+}
+
+/// Every `attr="…"` value in `text`.
+fn attrs(text: &str, attr: &str) -> Vec<String> {
+    let key = format!(" {attr}=\"");
     let mut out = Vec::new();
-    for key in ["src=\"", "href=\""] {
-        let mut rest = html;
-        while let Some(i) = rest.find(key) {
-            rest = &rest[i + key.len()..];
-            let end = rest.find('"').unwrap();
-            out.push(rest[..end].to_string());
-            rest = &rest[end..];
-        }
+    let mut rest = text;
+    while let Some(i) = rest.find(&key) {
+        rest = &rest[i + key.len()..];
+        let end = rest.find('"').unwrap();
+        out.push(rest[..end].to_string());
+        rest = &rest[end..];
     }
     out
 }
 
-fn percent_decode(s: &str) -> String {
-    let b = s.as_bytes();
-    let mut out = Vec::new();
-    let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'%' && i + 2 < b.len() {
-            out.push(u8::from_str_radix(&s[i + 1..i + 3], 16).unwrap());
-            i += 3;
-        } else {
-            out.push(b[i]);
-            i += 1;
+fn shoelace(pts: &[[f64; 2]]) -> f64 {
+    let n = pts.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (pts[i], pts[(i + 1) % n]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().unwrap()
+}
+
+/// The page's data is the designs' geometry: positions (rounded to 1e-4), triangles that
+/// tile every facet (the same total area), edges and assignments as the FOLD writer's.
+fn assert_geometry_matches(data: &Value, input: &ReportInput) {
+    let ds = data["designs"].as_array().unwrap();
+    assert_eq!(ds.len(), input.designs.len());
+    for (d, want) in ds.iter().zip(&input.designs) {
+        let p = &want.pattern;
+        let g = &d["geometry"];
+        assert_eq!(d["id"], want.id.as_str());
+        let flat = g["flat"].as_array().unwrap();
+        assert_eq!(flat.len(), p.vertices.len());
+        for (a, b) in flat.iter().zip(&p.vertices) {
+            assert!((f(&a[0]) - b[0]).abs() <= 5e-5 && (f(&a[1]) - b[1]).abs() <= 5e-5);
         }
+        let frames = g["frames"].as_array().unwrap();
+        assert_eq!(frames.len(), p.frames.len());
+        for (fr, want) in frames.iter().zip(&p.frames) {
+            let xs: Vec<f64> = fr.as_array().unwrap().iter().map(f).collect();
+            assert_eq!(xs.len(), 3 * want.coords.len());
+            for (k, c) in want.coords.iter().enumerate() {
+                for a in 0..3 {
+                    assert!((xs[3 * k + a] - c[a]).abs() <= 5e-5);
+                }
+            }
+        }
+        let tris: Vec<usize> = g["tris"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_u64().unwrap() as usize)
+            .collect();
+        assert_eq!(tris.len() % 3, 0);
+        let tri_area: f64 = tris
+            .chunks(3)
+            .map(|t| shoelace(&[p.vertices[t[0]], p.vertices[t[1]], p.vertices[t[2]]]))
+            .sum();
+        let face_area: f64 = p
+            .faces
+            .iter()
+            .map(|fc| shoelace(&fc.iter().map(|&v| p.vertices[v]).collect::<Vec<_>>()))
+            .sum();
+        assert!((tri_area - face_area).abs() < 1e-9 * face_area.max(1.0));
+        let assign: String = assignments(p).iter().map(|a| a.as_str()).collect();
+        assert_eq!(g["assign"], assign.as_str());
+        assert_eq!(g["edges"].as_array().unwrap().len(), p.edges.len());
+        assert_eq!(d["gripping"], json!(want.meta.gripping_vertex));
     }
-    String::from_utf8(out).unwrap()
 }
 
 #[test]
-fn report_links_resolve_and_page_is_self_contained() {
-    let dir = tempfile::tempdir().unwrap();
-    let report = build_report(dir.path());
-    let html = std::fs::read_to_string(&report).unwrap();
-    let ls = links(&html);
-    assert!(ls.len() >= 2 * (4 + 1 + 4 + 1 + 4), "{ls:?}");
-    for l in &ls {
-        assert!(
-            !l.contains("://") && !l.starts_with('/'),
-            "not a relative link: {l}"
-        );
-        assert!(dir.path().join(percent_decode(l)).is_file(), "missing: {l}");
+fn report_is_one_file_with_the_designs_geometry() {
+    for export in [true, false] {
+        let dir = tempfile::tempdir().unwrap();
+        let (report, input) = build_report(dir.path(), export);
+        let html = std::fs::read_to_string(&report).unwrap();
+        let m = markup(&html);
+        // Nothing is loaded: no src, no stylesheets, no CSS urls.
+        assert!(attrs(&m, "src").is_empty(), "{:?}", attrs(&m, "src"));
+        assert!(!m.contains("<link") && !m.contains("url(") && !m.contains("@import"));
+        assert!(!m.contains("<img"));
+        // Links only to files beside the report, and only when they were written.
+        let hrefs: Vec<String> = embedded(&html)["designs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .flat_map(|d| d["files"].as_array().unwrap().clone())
+            .map(|pair| pair[1].as_str().unwrap().to_string())
+            .collect();
+        assert_eq!(hrefs.is_empty(), !export);
+        for h in &hrefs {
+            assert!(!h.contains("://") && !h.starts_with('/'), "{h}");
+            assert!(dir.path().join(h).is_file(), "missing: {h}");
+        }
+        // three.js and the page's script are inline; the data parses and is the geometry.
+        assert_eq!(m.matches("<script>").count(), 2);
+        assert!(html.contains("FoldsynthThree"));
+        assert_geometry_matches(&embedded(&html), &input);
+        // Every design id is a table row, in the given order; gripping vertices by name.
+        let ids = attrs(&m, "data-id");
+        assert_eq!(ids, ["d-arm", "d-grip", "d-deg4"]);
+        assert!(m.contains("<td data-key=\"gripping\" data-v=\"7\">v7</td>"));
+        // Robustness columns exactly for the margins some design has.
+        let heads = attrs(&m, "data-key");
+        for k in [
+            "score",
+            "rigid_margin",
+            "self_clearance",
+            "obstacle_clearance",
+        ] {
+            assert!(heads.iter().any(|h| h == k), "{k}");
+        }
+        for k in ["arm_clearance", "min_feature"] {
+            assert!(!heads.iter().any(|h| h == k), "{k}");
+        }
+        // User text escaped; the task at the top.
+        assert!(m.contains("foldsynth report &amp; test"));
+        assert!(m.contains("demo &lt;degree 4&gt;") || html.contains("demo \\u003cdegree 4>"));
+        assert!(m.contains("<th>G0 vertices</th>"));
     }
-    // No scripts, no external resources.
-    assert!(!html.contains("<script") && !html.contains("@import") && !html.contains("url("));
-    // Two cards, each with an inline crease pattern; user text escaped.
-    assert_eq!(html.matches("<article class=\"card\">").count(), 2);
-    assert!(html.contains("demo gripper &lt;2&gt;"));
-    assert!(html.contains("foldsynth report &amp; test"));
 }
 
-fn find_chromium() -> Option<PathBuf> {
+#[test]
+fn report_refuses_duplicate_ids_and_out_of_range_gripping_vertices() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, mut input) = build_report(dir.path(), false);
+    input.designs[0].meta.gripping_vertex = Some(0);
+    let e = foldsynth::export::report::report_html(dir.path(), &input)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("d-arm") && e.contains("gripping_vertex"), "{e}");
+    let (_, mut input) = build_report(dir.path(), false);
+    input.designs[2].id = "d-arm".into();
+    let e = foldsynth::export::report::report_html(dir.path(), &input)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("designs[2].id"), "{e}");
+}
+
+fn foldsynth(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_foldsynth"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::null())
+        .output()
+        .unwrap()
+}
+
+/// A small search: report and summary named at the end, progress lines on stderr (not a
+/// terminal) for every phase, and one gripping-vertex number in the report, the design
+/// JSON (top level and meta) and the FOLD file, where it indexes (1-based) the vertex that
+/// reaches the target P_G = (0, 0, 1).
+#[test]
+fn search_writes_the_report_names_it_and_numbers_the_gripping_vertex_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("g1");
+    let o = foldsynth(&[
+        "synthesize",
+        "grammar/gripper.toml",
+        "--n-max",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stdout}\n{stderr}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    let n = lines.len();
+    assert_eq!(
+        lines[n - 2],
+        format!("report: {}", out.join("report.html").display())
+    );
+    assert_eq!(
+        lines[n - 1],
+        format!("summary: {}", out.join("summary.json").display())
+    );
+    for phase in [
+        "enumerate graphs: ",
+        "compile + optimize + check: 6/6 alternatives in ",
+        "write designs and their files: ",
+        "write report: done in ",
+    ] {
+        assert!(
+            stderr
+                .lines()
+                .any(|l| l.starts_with(&format!("progress: {phase}"))),
+            "{phase} missing in\n{stderr}"
+        );
+    }
+    let summary: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let ids: Vec<&str> = summary["designs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert!(!ids.is_empty());
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let data = embedded(&html);
+    let report_ids: Vec<&str> = data["designs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["id"].as_str().unwrap())
+        .collect();
+    assert_eq!(report_ids, ids);
+    for (id, d) in ids.iter().zip(data["designs"].as_array().unwrap()) {
+        let design: Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join("designs").join(format!("{id}.json"))).unwrap(),
+        )
+        .unwrap();
+        let g = design["gripping_vertex"].as_u64().unwrap();
+        assert_eq!(design["meta"]["gripping_vertex"], g);
+        assert_eq!(d["gripping"], g);
+        let fold_path = out.join("designs").join(id).join(format!("{id}.fold"));
+        let fold: Value =
+            serde_json::from_str(&std::fs::read_to_string(&fold_path).unwrap()).unwrap();
+        assert_eq!(fold["foldsynth:grippingVertex"], g);
+        let last = fold["file_frames"].as_array().unwrap().last().unwrap();
+        let p = &last["vertices_coords"][g as usize - 1];
+        let dist = ((f(&p[0])).powi(2) + f(&p[1]).powi(2) + (f(&p[2]) - 1.0).powi(2)).sqrt();
+        assert!(dist <= 1e-5, "{id}: v{g} ends {dist} from P_G");
+        // The page says the same: a table cell v{g} in the design's row.
+        assert!(html.contains(&format!(
+            "<td data-key=\"gripping\" data-v=\"{g}\">v{g}</td>"
+        )));
+    }
+}
+
+/// `--no-export` still writes the report (with the 3D views' geometry), and says so.
+#[test]
+fn no_export_run_writes_a_report_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("arm");
+    let o = foldsynth(&[
+        "synthesize",
+        "grammar/robotic_arm.toml",
+        "--n-max",
+        "1",
+        "--no-export",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    // --json keeps stdout one JSON document; the file names go to stderr.
+    let summary: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(stderr.contains(&format!("report: {}", out.join("report.html").display())));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("--no-export: design JSONs only"));
+    let data = embedded(&html);
+    assert_eq!(
+        data["designs"].as_array().unwrap().len(),
+        summary["designs"].as_array().unwrap().len()
+    );
+    for d in data["designs"].as_array().unwrap() {
+        assert_eq!(
+            d["files"].as_array().unwrap().len(),
+            1,
+            "only the design JSON"
+        );
+        assert!(!d["geometry"]["frames"].as_array().unwrap().is_empty());
+    }
+}
+
+// ---- in the browser -----------------------------------------------------------------------
+
+fn find_in_path(names: &[&str]) -> Option<PathBuf> {
     let path = std::env::var_os("PATH")?;
-    for name in ["chromium", "chromium-browser", "google-chrome"] {
+    for name in names {
         for dir in std::env::split_paths(&path) {
             let p = dir.join(name);
             if p.is_file() {
@@ -184,241 +463,355 @@ fn find_chromium() -> Option<PathBuf> {
     None
 }
 
-/// What the browser reported about one page.
-#[derive(Debug, Default)]
-struct PageReport {
-    errors: Vec<String>,
-    warnings: Vec<String>,
-    probe: Value,
+/// Chromium, node and the driver's node_modules, or why not.
+fn browser_tools() -> Result<(PathBuf, PathBuf, PathBuf), String> {
+    let chromium = match std::env::var_os("FOLDSYNTH_CHROMIUM").map(PathBuf::from) {
+        Some(p) if p.is_file() => p,
+        Some(p) => return Err(format!("FOLDSYNTH_CHROMIUM={} is not a file", p.display())),
+        None => find_in_path(&["chromium", "chromium-browser"])
+            .ok_or("chromium not found in PATH (Debian package `chromium`)")?,
+    };
+    let node = find_in_path(&["node", "nodejs"]).ok_or("node not found in PATH")?;
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/browser");
+    if !dir.join("node_modules/puppeteer-core").is_dir() {
+        return Err(format!(
+            "{}/node_modules is missing (run `npm ci` there)",
+            dir.display()
+        ));
+    }
+    Ok((chromium, node, dir))
 }
 
-struct Browser {
-    child: std::process::Child,
-    stdin: std::process::ChildStdin,
-    rx: mpsc::Receiver<Value>,
-    next_id: u64,
-    events: Vec<Value>,
+/// Run the driver on the pages; its JSON observations.
+fn drive(pages: &[&Path], broken: &Path) -> Value {
+    let (chromium, node, dir) = match browser_tools() {
+        Ok(t) => t,
+        Err(why) => {
+            if std::env::var("FOLDSYNTH_REQUIRE_BROWSER").as_deref() == Ok("1") {
+                panic!("FOLDSYNTH_REQUIRE_BROWSER=1 but {why}");
+            }
+            println!("SKIPPED: {why}");
+            return Value::Null;
+        }
+    };
+    let mut cmd = Command::new(node);
+    cmd.arg(dir.join("report_check.mjs"))
+        .arg("--chromium")
+        .arg(&chromium)
+        .arg("--broken")
+        .arg(broken)
+        .args(pages)
+        .current_dir(&dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let mut child = cmd.spawn().unwrap();
+    let mut stdout = child.stdout.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut s = String::new();
+        stdout.read_to_string(&mut s).unwrap();
+        s
+    });
+    let deadline = Instant::now() + Duration::from_secs(240);
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("the browser driver ran for more than 240 s");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    let out = reader.join().unwrap();
+    assert!(status.success(), "driver failed: {err}\n{out}");
+    let v: Value = serde_json::from_str(out.trim())
+        .unwrap_or_else(|e| panic!("driver output is not JSON ({e}): {out}\n{err}"));
+    assert!(v.get("failure").is_none(), "driver: {}", v["failure"]);
+    v
 }
 
-impl Browser {
-    fn start(exe: &Path, profile: &Path) -> Browser {
-        // fd 3 = commands (our stdin), fd 4 = replies (our stdout).
-        let mut child = Command::new("sh")
-            .arg("-c")
-            .arg("exec \"$0\" \"$@\" 3<&0 4>&1 </dev/null >/dev/null 2>/dev/null")
-            .arg(exe)
-            .args([
-                "--headless",
-                "--no-sandbox",
-                "--disable-gpu",
-                "--disable-quic",
-                "--no-first-run",
-                "--disable-background-networking",
-                "--disable-component-update",
-                "--disable-sync",
-                "--remote-debugging-pipe",
-            ])
-            .arg(format!("--user-data-dir={}", profile.display()))
-            .arg("about:blank")
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .spawn()
-            .expect("start chromium");
-        let stdin = child.stdin.take().unwrap();
-        let stdout = child.stdout.take().unwrap();
-        let (tx, rx) = mpsc::channel();
-        std::thread::spawn(move || {
-            let mut r = BufReader::new(stdout);
-            loop {
-                let mut buf = Vec::new();
-                match r.read_until(0, &mut buf) {
-                    Ok(0) | Err(_) => break,
-                    Ok(_) => {
-                        buf.pop();
-                        if let Ok(v) = serde_json::from_slice::<Value>(&buf)
-                            && tx.send(v).is_err()
-                        {
-                            break;
-                        }
-                    }
-                }
-            }
-        });
-        Browser {
-            child,
-            stdin,
-            rx,
-            next_id: 0,
-            events: Vec::new(),
-        }
-    }
+/// A copy of `report` alone in a fresh folder.
+fn alone(report: &Path, dir: &Path, name: &str) -> PathBuf {
+    let d = dir.join(name);
+    std::fs::create_dir_all(&d).unwrap();
+    let p = d.join("report.html");
+    std::fs::copy(report, &p).unwrap();
+    p
+}
 
-    fn send(&mut self, method: &str, params: Value, session: Option<&str>) -> u64 {
-        self.next_id += 1;
-        let mut msg = json!({"id": self.next_id, "method": method, "params": params});
-        if let Some(s) = session {
-            msg["sessionId"] = s.into();
-        }
-        let mut bytes = serde_json::to_vec(&msg).unwrap();
-        bytes.push(0);
-        self.stdin.write_all(&bytes).unwrap();
-        self.stdin.flush().unwrap();
-        self.next_id
-    }
+fn ids(v: &Value) -> Vec<String> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_str().unwrap().to_string())
+        .collect()
+}
 
-    fn wait(&mut self, until: impl Fn(&Value) -> bool, what: &str) -> Value {
-        let deadline = Instant::now() + Duration::from_secs(60);
-        loop {
-            let left = deadline.saturating_duration_since(Instant::now());
-            let v = self
-                .rx
-                .recv_timeout(left)
-                .unwrap_or_else(|e| panic!("chromium: no {what} ({e})"));
-            if let Some(err) = v.get("error") {
-                panic!("chromium: {what} failed: {err}");
-            }
-            if until(&v) {
-                return v;
-            }
-            if v.get("method").is_some() {
-                self.events.push(v);
-            }
-        }
-    }
+/// Row ids sorted by a numeric column the way a stable sort does: ties (and missing
+/// values, always last) keep the original order.
+fn expected_order(rows: &[(String, Option<f64>)], dir: f64) -> Vec<String> {
+    let mut idx: Vec<usize> = (0..rows.len()).collect();
+    idx.sort_by(|&a, &b| match (rows[a].1, rows[b].1) {
+        (Some(x), Some(y)) => (dir * x).partial_cmp(&(dir * y)).unwrap().then(a.cmp(&b)),
+        (Some(_), None) => std::cmp::Ordering::Less,
+        (None, Some(_)) => std::cmp::Ordering::Greater,
+        (None, None) => a.cmp(&b),
+    });
+    idx.into_iter().map(|i| rows[i].0.clone()).collect()
+}
 
-    fn call(&mut self, method: &str, params: Value, session: Option<&str>) -> Value {
-        let id = self.send(method, params, session);
-        self.wait(|v| v["id"] == id, method)["result"].clone()
-    }
+/// The numeric value of column `key` per design, from the embedded data.
+fn column(data: &Value, key: &str) -> Vec<(String, Option<f64>)> {
+    data["designs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| {
+            let v = match key {
+                "objective" | "level" | "candidate" => d[key].as_f64(),
+                "score" => d["robustness"]["score"].as_f64(),
+                m => d["robustness"][m]["value"].as_f64(),
+            };
+            (d["id"].as_str().unwrap().to_string(), v)
+        })
+        .collect()
+}
 
-    /// Load a page, wait for its load event, then collect console errors, exceptions,
-    /// failed loads, and the result of a probe expression.
-    fn load(&mut self, url: &str, probe: &str) -> PageReport {
-        let target = self.call("Target.createTarget", json!({"url": "about:blank"}), None);
-        let tid = target["targetId"].as_str().unwrap().to_string();
-        let att = self.call(
-            "Target.attachToTarget",
-            json!({"targetId": tid, "flatten": true}),
-            None,
-        );
-        let sid = att["sessionId"].as_str().unwrap().to_string();
-        for m in ["Runtime.enable", "Log.enable", "Page.enable"] {
-            self.call(m, json!({}), Some(&sid));
-        }
-        self.events.clear();
-        self.call("Page.navigate", json!({"url": url}), Some(&sid));
-        let s2 = sid.clone();
-        self.wait(
-            move |v| v["method"] == "Page.loadEventFired" && v["sessionId"] == s2.as_str(),
-            "load event",
-        );
-        let probe = self.call(
-            "Runtime.evaluate",
-            json!({"expression": probe, "returnByValue": true}),
-            Some(&sid),
-        )["result"]["value"]
-            .clone();
-        let mut r = PageReport {
-            probe,
-            ..PageReport::default()
+/// What every report must show in the browser, whatever its designs.
+fn assert_page_works(r: &Value, data: &Value) {
+    let file = &r["file"];
+    assert_eq!(r["errors"], json!([]), "{file}: console errors");
+    assert_eq!(
+        r["requests"],
+        json!([]),
+        "{file}: the page loaded something"
+    );
+    let designs = data["designs"].as_array().unwrap();
+    let init = &r["initial"];
+    assert_eq!(init["detail"]["webgl"], true, "{file}");
+    // The 3D view is drawn: a good share of the canvas is not background.
+    let px = &r["pixels_initial"];
+    assert!(
+        f(&px["ink"]) > 0.01 * f(&px["total"]),
+        "{file}: 3D canvas nearly empty: {px}"
+    );
+    // The slider: Home is the flat state (t = 0), End the last frame (t = t_max); the
+    // picture changes between them.
+    let sel = init["detail"]["selected"].as_str().unwrap();
+    let d = designs.iter().find(|d| d["id"] == sel).unwrap();
+    let ts = d["geometry"]["t"].as_array().unwrap();
+    let home = &r["slider_home"]["detail"];
+    assert_eq!(home["frame"], 0, "{file}");
+    assert!(home["t"].as_str().unwrap().starts_with("t = 0.0000 "));
+    let end = &r["slider_end"]["detail"];
+    assert_eq!(f(&end["frame"]) as usize, ts.len() - 1, "{file}");
+    assert!(
+        end["t"]
+            .as_str()
+            .unwrap()
+            .starts_with(&format!("t = {:.4} ", f(ts.last().unwrap()))),
+        "{}",
+        end["t"]
+    );
+    assert!(
+        f(&r["slider_end"]["changed_vs_home"]) >= 10.0,
+        "{file}: moving the slider did not change the picture"
+    );
+    assert!(f(&r["drag"]["changed_vs_end"]) >= 10.0, "{file}: drag");
+    assert_ne!(
+        r["play"]["frame_before"], r["play"]["frame_after"],
+        "{file}"
+    );
+    assert_eq!(r["play"]["button"], "play");
+    // The crease pattern of the selected design: one line per edge, its assignment, the
+    // vertices named v1 … vn, the gripping vertex circled.
+    let cp = &init["detail"]["cp"];
+    let assign: Vec<String> = d["geometry"]["assign"]
+        .as_str()
+        .unwrap()
+        .chars()
+        .map(String::from)
+        .collect();
+    assert_eq!(ids(&cp["lines"]), assign);
+    let n = d["geometry"]["flat"].as_array().unwrap().len();
+    assert_eq!(
+        ids(&cp["labels"]),
+        (1..=n).map(|k| format!("v{k}")).collect::<Vec<_>>()
+    );
+    assert_eq!(cp["circles"], 1);
+    // Sorting by a numeric column orders the rows by it (stable), both ways.
+    for key in [
+        "objective",
+        "level",
+        "score",
+        "rigid_margin",
+        "self_clearance",
+    ] {
+        let Some(s) = r["sorts"].get(key) else {
+            continue;
         };
-        for e in &self.events {
-            let p = &e["params"];
-            match e["method"].as_str() {
-                Some("Runtime.exceptionThrown") => r
-                    .errors
-                    .push(format!("exception: {}", p["exceptionDetails"])),
-                Some("Runtime.consoleAPICalled") => {
-                    let msg = format!("console.{}: {}", p["type"], p["args"]);
-                    match p["type"].as_str() {
-                        Some("error" | "assert") => r.errors.push(msg),
-                        Some("warning") => r.warnings.push(msg),
-                        _ => {}
-                    }
-                }
-                Some("Log.entryAdded") => {
-                    let msg = format!(
-                        "{}: {} {}",
-                        p["entry"]["source"], p["entry"]["text"], p["entry"]["url"]
-                    );
-                    match p["entry"]["level"].as_str() {
-                        Some("error") => r.errors.push(msg),
-                        Some("warning") => r.warnings.push(msg),
-                        _ => {}
-                    }
-                }
-                _ => {}
-            }
-        }
-        r
+        let col = column(data, key);
+        assert_eq!(ids(&s["asc"]), expected_order(&col, 1.0), "{file}: {key}");
+        assert_eq!(ids(&s["desc"]), expected_order(&col, -1.0), "{file}: {key}");
+        assert_eq!(s["aria"], "descending");
     }
-}
-
-impl Drop for Browser {
-    fn drop(&mut self) {
-        let _ = self.send("Browser.close", json!({}), None);
-        let deadline = Instant::now() + Duration::from_secs(10);
-        while Instant::now() < deadline {
-            if let Ok(Some(_)) = self.child.try_wait() {
-                return;
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+    // Filters keep exactly the matching rows.
+    let all: Vec<&Value> = designs.iter().collect();
+    let keep = |pred: &dyn Fn(&Value) -> bool| -> Vec<String> {
+        all.iter()
+            .filter(|d| pred(d))
+            .map(|d| d["id"].as_str().unwrap().to_string())
+            .collect()
+    };
+    let visible = |k: &str| -> Vec<String> {
+        let mut v = ids(&r["filters"][k]["visible"]);
+        v.sort();
+        v
+    };
+    let sorted = |mut v: Vec<String>| {
+        v.sort();
+        v
+    };
+    let level: f64 = r["filters"]["level"]["value"]
+        .as_str()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(visible("level"), sorted(keep(&|d| f(&d["level"]) == level)));
+    let modes = r["filters"]["modes"]["value"].as_str().unwrap().to_string();
+    assert_eq!(
+        visible("modes"),
+        sorted(keep(&|d| d["modes"] == modes.as_str()))
+    );
+    let limit = f(&r["filters"]["objective"]["value"]);
+    assert_eq!(
+        visible("objective"),
+        sorted(keep(&|d| f(&d["objective"]) <= limit))
+    );
+    assert_eq!(
+        r["filters"]["objective"]["shown"].as_str().unwrap(),
+        visible("objective").len().to_string()
+    );
+    if r["filters"].get("score").is_some() {
+        assert_eq!(
+            visible("score"),
+            sorted(keep(&|d| d["robustness"]["score"]
+                .as_f64()
+                .is_some_and(|s| s >= 1.5)))
+        );
     }
-}
-
-const PROBE: &str = "JSON.stringify({images: Array.from(document.images).map(i => [i.getAttribute('src'), i.complete && i.naturalWidth > 0]), svgs: document.querySelectorAll('svg').length, cards: document.querySelectorAll('article.card').length, height: document.body.scrollHeight})";
-
-fn file_url(p: &Path) -> String {
-    let abs = p.canonicalize().unwrap();
-    format!("file://{}", abs.display()).replace(' ', "%20")
+    // Clicking a row shows that design, named by its id.
+    let clicked = r["select"]["clicked"].as_str().unwrap();
+    assert_eq!(r["select"]["detail"]["selected"], clicked);
+    assert!(
+        r["select"]["detail"]["title"]
+            .as_str()
+            .unwrap()
+            .starts_with(clicked)
+    );
 }
 
 #[test]
-fn report_renders_in_headless_chromium_without_errors() {
-    let Some(exe) = find_chromium() else {
-        println!(
-            "SKIPPED: chromium not found in PATH (install Debian's `chromium` to run this check)"
-        );
-        return;
-    };
+fn report_works_in_headless_chromium_moved_alone() {
     let dir = tempfile::tempdir().unwrap();
-    let report = build_report(&dir.path().join("out"));
-
-    // A deliberately broken page first: the harness must see its errors.
+    // The sample report (robustness columns, files written), then moved alone.
+    let (sample, _) = build_report(&dir.path().join("out"), true);
+    let sample = alone(&sample, dir.path(), "sample");
+    // A real search's report (gripper, N_max 2, --no-export: fast), moved alone.
+    let run = dir.path().join("run");
+    let o = foldsynth(&[
+        "synthesize",
+        "grammar/gripper.toml",
+        "--n-max",
+        "2",
+        "--no-export",
+        "--out",
+        run.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let real = alone(&run.join("report.html"), dir.path(), "real");
+    std::fs::remove_dir_all(dir.path().join("out")).unwrap();
+    std::fs::remove_dir_all(&run).unwrap();
+    // A deliberately broken page: the driver must see its errors.
     let broken = dir.path().join("broken.html");
     std::fs::write(
         &broken,
-        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>b</title></head><body><img src=\"nope.png\"><script>console.error('boom'); undefined_fn();</script></body></html>",
+        "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>b</title></head><body><script>console.error('boom'); undefined_fn();</script></body></html>",
     )
     .unwrap();
 
-    let mut browser = Browser::start(&exe, &dir.path().join("profile"));
-    let bad = browser.load(&file_url(&broken), PROBE);
-    assert!(bad.errors.iter().any(|e| e.contains("boom")), "{bad:?}");
+    let v = drive(&[&sample, &real], &broken);
+    if v.is_null() {
+        return;
+    }
+    let bad = ids(&v["broken"]["errors"]).join("\n");
     assert!(
-        bad.errors.iter().any(|e| e.contains("exception")),
-        "{bad:?}"
+        bad.contains("boom") && bad.contains("undefined_fn"),
+        "{bad}"
     );
-    let probe: Value = serde_json::from_str(bad.probe.as_str().unwrap()).unwrap();
-    assert_eq!(probe["images"][0][1], false, "{probe}");
-
-    let good = browser.load(&file_url(&report), PROBE);
-    assert!(good.errors.is_empty(), "console errors: {:#?}", good.errors);
-    for w in &good.warnings {
-        println!("warning: {w}");
+    let reports = v["reports"].as_array().unwrap();
+    assert_eq!(reports.len(), 2);
+    for (r, page) in reports.iter().zip([&sample, &real]) {
+        let data = embedded(&std::fs::read_to_string(page).unwrap());
+        assert_page_works(r, &data);
     }
-    let probe: Value = serde_json::from_str(good.probe.as_str().unwrap()).unwrap();
-    let images = probe["images"].as_array().unwrap();
-    // Per design: 4 state pictures and the animation.
-    assert_eq!(images.len(), 2 * 5, "{probe}");
-    for img in images {
-        assert_eq!(img[1], true, "image did not load: {img}");
-    }
-    assert_eq!(probe["cards"], 2);
-    // Tree, distribution, and per card the crease pattern.
-    assert!(probe["svgs"].as_u64().unwrap() >= 4, "{probe}");
-    assert!(probe["height"].as_u64().unwrap() > 500, "{probe}");
+    // The sample has robustness: shown most robust first, margins as columns.
+    let s = &reports[0];
+    assert_eq!(ids(&s["initial"]["table"]["order"])[0], "d-grip");
+    let heads: Vec<String> = s["initial"]["table"]["headers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|h| h[0].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(
+        heads,
+        [
+            "id",
+            "sequence",
+            "level",
+            "candidate",
+            "gripping",
+            "modes",
+            "objective",
+            "score",
+            "rigid_margin",
+            "self_clearance",
+            "obstacle_clearance"
+        ]
+    );
+    let facts = &s["initial"]["detail"]["facts"];
+    let text = facts.to_string();
+    assert!(text.contains("self clearance") && text.contains("facets f1–f3"));
+    // Sorting reorders: by objective ascending is not the search's order.
+    assert_ne!(
+        ids(&s["sorts"]["objective"]["asc"]),
+        ["d-arm", "d-grip", "d-deg4"]
+    );
+    // The real report: the search's order, the first design selected, t up to π/2.
+    let r = &reports[1];
+    let order = ids(&r["initial"]["table"]["order"]);
+    let data = embedded(&std::fs::read_to_string(&real).unwrap());
+    let want: Vec<String> = data["designs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["id"].as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(order, want);
+    assert_eq!(r["initial"]["detail"]["selected"], want[0].as_str());
+    assert!(
+        r["slider_end"]["detail"]["t"]
+            .as_str()
+            .unwrap()
+            .starts_with("t = 1.5708 (90.0°)")
+    );
 }

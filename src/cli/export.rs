@@ -73,7 +73,7 @@ pub struct ExportArgs {
     /// (0-based; default: the last frame).
     #[arg(long)]
     pub frame: Option<usize>,
-    /// Vertex numbers in the crease pattern SVG.
+    /// Vertex names (v1, v2, …) in the crease pattern SVG.
     #[arg(long)]
     pub labels: bool,
     /// Grey instead of Origami Simulator's yellow for flat creases.

@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 pub mod bench;
 pub mod bench_model;
 pub mod bench_numeric;
+pub mod compile;
 pub mod enumerate;
 pub mod export;
 pub mod formulas;
@@ -46,6 +47,8 @@ pub enum Command {
     Formulas(formulas::FormulasArgs),
     /// The optimization model of one graph: variables, constraints, compiled, verified.
     Model(model::ModelArgs),
+    /// Compile one design model ahead of time: object, shared library, C header, manifest.
+    Compile(compile::CompileArgs),
     /// Write one design (from a design JSON) as FOLD, SVG, OBJ, STL, GIF or PNG.
     Export(export::ExportArgs),
     /// Check a FOLD file: isometry of every folded frame, fold angles, face consistency.
@@ -101,6 +104,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(a) => bench::run(a),
         Command::Formulas(a) => formulas::run(a),
         Command::Model(a) => model::run(a),
+        Command::Compile(a) => compile::run(a),
         Command::Export(a) => export::run(a),
         Command::Verify(a) => verify::run(a),
         Command::Simulate(a) => simulate::run(a),

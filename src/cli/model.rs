@@ -47,8 +47,8 @@ pub struct ModelArgs {
     /// Seed for --optimize.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Number of states of the verification sweep over [0, t_max].
-    #[arg(long, default_value_t = 97)]
+    /// Number of states of the verification sweep over [0, t_max] (as `synthesize --sweep`).
+    #[arg(long, default_value_t = crate::search::SearchOptions::default().sweep)]
     pub sweep: usize,
     /// Print JSON.
     #[arg(long)]

@@ -18,7 +18,7 @@ pub struct SynthesizeArgs {
     /// run of the same settings (see --force).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Worker threads, 0 (one per core) to 256.
+    /// Worker threads; 0 means one per core (at most 256).
     #[arg(long, default_value_t = 0, value_parser = limits::count::<0, { limits::JOBS_MAX as u64 }>)]
     pub jobs: usize,
     /// Starting points per design alternative, 1 to 1000.
@@ -38,10 +38,12 @@ pub struct SynthesizeArgs {
     /// Override the task's maximum number of internal vertices, 1 to 6.
     #[arg(long, value_parser = limits::count::<1, { limits::N_MAX as u64 }>)]
     pub n_max: Option<usize>,
-    /// States of the rigidity/verification sweep over [0, t_max], 2 to 10000.
+    /// States of the rigidity/verification sweep over [0, t_max], 2 to 10000 (181: every 0.5°
+    /// of a π/2 motion; `model --sweep` has the same default).
     #[arg(long, default_value_t = SearchOptions::default().sweep, value_parser = limits::count::<2, { limits::SWEEP_MAX as u64 }>)]
     pub sweep: usize,
-    /// Skip the FOLD/SVG/OBJ/STL/picture/animation files and the report.
+    /// Skip the per-design FOLD/SVG/OBJ/STL/picture/animation files (the design JSONs and
+    /// report.html, with its 3D views, are written either way).
     #[arg(long)]
     pub no_export: bool,
     /// Run only shard K of N (1 ≤ K ≤ N) of the search: a deterministic, cost-balanced
@@ -105,11 +107,18 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         return Ok(());
     }
     let summary = search::run(&task, &opts)?;
+    let files = format!(
+        "report: {}\nsummary: {}\n",
+        out.join("report.html").display(),
+        out.join("summary.json").display()
+    );
     if args.json {
+        // stdout stays one JSON document; the file names go to stderr.
         println!("{}", serde_json::to_string_pretty(&summary)?);
+        eprint!("{files}");
     } else {
         print!("{}", summary.text());
-        println!("results in {}", out.display());
+        print!("{files}");
     }
     if summary.verification_failures > 0 {
         return Err(super::CheckFailed(format!(

@@ -22,19 +22,23 @@
 //! assert!((buf[c.layout.gradient(0).start] - d).abs() < 1e-15);
 //! ```
 //!
-//! Stages: [`simplify`] (egg), [`diff`] (reverse mode), [`jit`] (Cranelift); [`dual`] is
+//! Stages: [`simplify`] (egg), [`diff`] (reverse mode), [`codegen`] (the Cranelift function
+//! builder) behind [`jit`] (in process) and [`aot`] (object, shared library, C header); [`dual`] is
 //! the forward-mode oracle the tests hold the differentiator to; [`vertex`] builds the
 //! symbolic PTU of one vertex (for `foldsynth formulas` and `foldsynth bench vertex`).
 
+pub mod aot;
+pub mod codegen;
 pub mod diff;
 pub mod dual;
 pub mod jit;
 pub mod simplify;
 pub mod vertex;
 
+pub use codegen::{CompileError, OptLevel};
 pub use diff::{gradient, gradients};
 pub use dual::Dual;
-pub use jit::{CompileError, CompiledFn, OptLevel};
+pub use jit::CompiledFn;
 
 use crate::expr::{Counts, ExprGraph, NodeId, check_indices};
 use std::time::Instant;

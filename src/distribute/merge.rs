@@ -458,5 +458,6 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
         &search_opts,
         &ev,
         start,
+        &search::Progress::new(search_opts.progress),
     )?)
 }

@@ -18,7 +18,8 @@
 //!
 //! foldsynth's own data uses the spec's custom-property convention (a colon in the key):
 //! `foldsynth:task`, `foldsynth:ruleSequence`, `foldsynth:modes`, `foldsynth:grippingVertex`
-//! (0-based), `foldsynth:objective`, `foldsynth:frameT` (t of each entry of `file_frames`),
+//! (the vertex name K of `vK`, 1-based as in foldsynth's rule sequences, report and design
+//! JSON: its coordinates are `vertices_coords[K − 1]`), `foldsynth:objective`, `foldsynth:frameT` (t of each entry of `file_frames`),
 //! `foldsynth:targets`, `foldsynth:trajectory`, `foldsynth:obstacle`,
 //! `foldsynth:secondArm`, `foldsynth:extra`, and per edge `edges_foldsynth:driven`.
 //!

@@ -11,7 +11,7 @@
 //! - [`render`]: folded states as PNG, SVG and animated GIF,
 //! - [`mesh`]: OBJ and STL of a folded state,
 //! - [`plots`]: the search tree (thesis Fig. 48) and the distribution of designs (Fig. 51),
-//! - [`report`]: the self-contained `report.html`,
+//! - [`report`]: the self-contained, interactive `report.html` (three.js inlined),
 //! - [`samples`]: small patterns with exact rigid motions (tests and demos).
 //!
 //! ```
@@ -87,7 +87,9 @@ pub struct DesignMeta {
     /// RBM of every internal vertex, in the order of the internal vertices.
     #[serde(default)]
     pub modes: Vec<Mode>,
-    /// The gripping vertex, a 0-based index into [`Pattern::vertices`].
+    /// The gripping vertex by its name: 1-based, as vertices are numbered everywhere
+    /// foldsynth talks to people (task files, rule sequences, the report, the design JSON's
+    /// top-level `gripping_vertex`), so vertex `vK` is [`Pattern::vertices`]`[K − 1]`.
     #[serde(default)]
     pub gripping_vertex: Option<usize>,
     /// The objective value Ω* of the optimized design.
@@ -248,12 +250,12 @@ pub fn validate_pattern(p: &Pattern) -> Result<()> {
 /// Check the metadata against the pattern it describes.
 pub fn validate_meta(meta: &DesignMeta, p: &Pattern) -> Result<()> {
     if let Some(g) = meta.gripping_vertex
-        && g >= p.vertices.len()
+        && !(1..=p.vertices.len()).contains(&g)
     {
         return Err(ExportError::invalid(
             "meta.gripping_vertex",
             format!(
-                "vertex {g} out of range (the pattern has {} vertices; 0-based)",
+                "vertex {g} out of range: vertices are numbered 1 to {} (v1, v2, …)",
                 p.vertices.len()
             ),
         ));

@@ -256,7 +256,8 @@ impl<'a> Scene<'a> {
                 dashed: false,
             });
         }
-        if let Some(g) = self.meta.gripping_vertex {
+        // Validated as 1..=n: the vertex name vK is index K − 1.
+        if let Some(g) = self.meta.gripping_vertex.map(|g| g - 1) {
             if self.pattern.frames.len() >= 2 {
                 items.push(Item::Polyline {
                     pts: self

@@ -185,12 +185,12 @@ pub fn degree4(gamma: f64, t_max: f64, frames: usize) -> Pattern {
 /// (target, cylinder obstacle, two arms).
 pub fn demo_gripper() -> (Pattern, DesignMeta) {
     let p = degree4(PI / 3.0, PI / 2.0, 9);
-    let g = 6;
+    let g = 6; // index; the metadata names it v7
     let meta = DesignMeta {
         task: "demo gripper".into(),
         rule_sequence: "2".into(),
         modes: vec![Mode::Down],
-        gripping_vertex: Some(g),
+        gripping_vertex: Some(g + 1),
         objective: Some(0.0),
         targets: vec![TargetPoint {
             p: p.frames.last().map_or([0.0; 3], |f| f.coords[g]),
@@ -209,10 +209,10 @@ pub fn demo_gripper() -> (Pattern, DesignMeta) {
 }
 
 /// A demo design with a trajectory (robotic-arm style): [`single_crease`], the tip vertex
-/// 4 following its own circular path, with target points along it.
+/// v5 (index 4) following its own circular path, with target points along it.
 pub fn demo_arm() -> (Pattern, DesignMeta) {
     let p = single_crease(PI / 2.0, 11);
-    let g = 4;
+    let g = 4; // index; the metadata names it v5
     let targets: Vec<TargetPoint> = p
         .frames
         .iter()
@@ -232,7 +232,7 @@ pub fn demo_arm() -> (Pattern, DesignMeta) {
         task: "demo arm".into(),
         rule_sequence: String::new(),
         modes: Vec::new(),
-        gripping_vertex: Some(g),
+        gripping_vertex: Some(g + 1),
         objective: Some(0.0),
         targets,
         trajectory,

@@ -15,7 +15,8 @@
 //!   in Origami Simulator this gives the mirror image of our folded state, with the same
 //!   mountains and valleys.
 //! - Each line carries `data-edge`, `data-assignment`, `data-fold-angle` (degrees) and
-//!   `data-driven` attributes; importers ignore them. Vertex numbers (`labels`) are
+//!   `data-driven` attributes; importers ignore them. Vertex names (`labels`: v1, v2, …,
+//!   1-based like everywhere foldsynth numbers vertices for people) are
 //!   `<text>` elements, which Origami Simulator ignores too.
 
 use std::fmt::Write as _;
@@ -134,7 +135,7 @@ pub fn crease_pattern_element(p: &Pattern, o: &SvgOptions) -> Result<String> {
                 "<text x=\"{:.2}\" y=\"{:.2}\" font-family=\"sans-serif\" font-size=\"12\" fill=\"#333333\">{}</text>",
                 x(*v) + 3.0,
                 y(*v) - 3.0,
-                xml_escape(&i.to_string())
+                xml_escape(&format!("v{}", i + 1))
             );
         }
     }

@@ -9,6 +9,7 @@
 
 pub mod compiled;
 pub mod geometry;
+pub mod interface;
 pub mod linalg;
 pub mod numeric;
 pub mod plan;

@@ -17,10 +17,13 @@
 
 pub mod output;
 pub mod plan;
+mod progress;
 mod record;
+mod report;
 mod run;
 
 pub use plan::Plan;
+pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
 pub use record::{AlternativeRecord, Summary, Tally, Timings, level_distribution};
 pub use run::{
     Alternative, Evaluation, FailedModel, SHARD_REPORT, SHARD_TASK, SearchError, SearchOptions,

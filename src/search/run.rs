@@ -2,7 +2,9 @@
 
 use super::output::{self, OutputDir, RECORDS, RunSettings, SETTINGS, ShardSpec};
 use super::plan::{Done, Plan};
+use super::progress::Progress;
 use super::record::{AlternativeRecord, Summary, Tally, Timings};
+use super::report::{report_design, report_input, task_facts};
 use crate::check::verify::{Tolerances, verify};
 use crate::check::{CheckError, Cylinder, MotionSettings, check_frames, two_armed};
 use crate::compile::Options as CompileOptions;
@@ -15,13 +17,12 @@ use crate::model::{Model, ModelError};
 use crate::optimize::{self, minimize};
 use crate::pattern::Pattern;
 use crate::task::Task;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{BufRead, BufReader, IsTerminal, Seek, SeekFrom, Write};
+use std::io::{BufRead, BufReader, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -48,9 +49,11 @@ pub struct SearchOptions {
     pub n_max: Option<usize>,
     /// States of the verification sweep over [0, t_max].
     pub sweep: usize,
-    /// Write FOLD/SVG/OBJ/STL/pictures/GIF for every feasible design and the report.
+    /// Write FOLD/SVG/OBJ/STL/pictures/GIF for every feasible design (the design JSONs and
+    /// the report are written either way).
     pub export: bool,
-    /// Show a progress bar on stderr (only drawn on a terminal).
+    /// Show progress on stderr: a bar on a terminal, a status line every few seconds
+    /// otherwise (see [`Progress`]).
     pub progress: bool,
 }
 
@@ -477,11 +480,19 @@ pub fn open_output(
 pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     let start = Instant::now();
     let n_max = check_search(task, opts)?;
+    let progress = Progress::new(opts.progress);
+    progress.phase("enumerate graphs", "graphs", None);
     let plan = plan(task, n_max)?;
+    progress.inc(plan.graphs.len() as u64);
+    progress.finish_phase_with(&format!(
+        "{} generated, {} meaningful",
+        plan.generated,
+        plan.graphs.len()
+    ));
     let (out, resume) = open_output(&settings(task, n_max, opts, None), opts)?;
     let all: Vec<usize> = (0..plan.units.len()).collect();
-    let ev = evaluate_units(task, &plan, &all, &out, resume, opts)?;
-    finish(task, &plan, &out, opts, &ev, start)
+    let ev = evaluate_units(task, &plan, &all, &out, resume, opts, &progress)?;
+    finish(task, &plan, &out, opts, &ev, start, &progress)
 }
 
 /// Run shard `share` of the search of `task` (planned as `plan`) into `opts.out`: its
@@ -496,7 +507,9 @@ pub fn run_shard(
     let n_max = check_search(task, opts)?;
     let (out, resume) = open_output(&settings(task, n_max, opts, Some(share.spec)), opts)?;
     out.write(SHARD_TASK, share.task_text)?;
-    let ev = evaluate_units(task, plan, share.units, &out, resume, opts)?;
+    let progress = Progress::new(opts.progress);
+    let ev = evaluate_units(task, plan, share.units, &out, resume, opts, &progress)?;
+    drop(progress);
     let tally = tally_records(plan, &out.path(RECORDS))?.0;
     let report = ShardReport {
         shard: share.spec,
@@ -536,6 +549,7 @@ pub fn evaluate_units(
     out: &OutputDir,
     resume: bool,
     opts: &SearchOptions,
+    progress: &Progress,
 ) -> Result<Evaluation, SearchError> {
     let mut mine = vec![false; plan.units.len()];
     for &u in units {
@@ -580,18 +594,11 @@ pub fn evaluate_units(
     let write_error: Mutex<Option<std::io::Error>> = Mutex::new(None);
     let compile_s = Mutex::new(0.0f64);
     let failed: Mutex<Vec<FailedModel>> = Mutex::new(Vec::new());
-    let bar = if opts.progress && std::io::stderr().is_terminal() {
-        let b = ProgressBar::with_draw_target(Some(remaining as u64), ProgressDrawTarget::stderr());
-        b.set_style(
-            ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} alternatives ({eta}) {msg}",
-            )
-            .expect("valid template"),
-        );
-        b
-    } else {
-        ProgressBar::hidden()
-    };
+    progress.phase(
+        "compile + optimize + check",
+        "alternatives",
+        Some(remaining as u64),
+    );
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
         .build()
@@ -624,7 +631,7 @@ pub fn evaluate_units(
                             candidate: unit.candidate + 1,
                             error,
                         });
-                    bar.inc(modes.len() as u64);
+                    progress.inc(modes.len() as u64);
                     return;
                 }
             };
@@ -641,12 +648,12 @@ pub fn evaluate_units(
                         first.get_or_insert(e);
                     }
                 }
-                bar.inc(1);
+                progress.inc(1);
             });
             // `prepared` (the native code) is dropped here, with its last alternative.
         });
     });
-    bar.finish_and_clear();
+    progress.finish_phase();
     if let Some(e) = write_error.into_inner().ok().flatten() {
         // A record that is not on disk would be lost to --resume: stop here.
         return Err(SearchError::Io {
@@ -715,6 +722,7 @@ pub fn finish(
     opts: &SearchOptions,
     ev: &Evaluation,
     start: Instant,
+    progress: &Progress,
 ) -> Result<Summary, SearchError> {
     let records = out.path(RECORDS);
     let (tally, designs) = tally_records(plan, &records)?;
@@ -761,7 +769,9 @@ pub fn finish(
 
     let t2 = Instant::now();
     summary.timings.total_s = start.elapsed().as_secs_f64();
-    write_designs(task, plan, &records, &designs, &summary, opts, out)?;
+    write_designs(
+        task, plan, &records, &designs, &summary, opts, out, progress,
+    )?;
     timings.export_s = t2.elapsed().as_secs_f64();
     timings.total_s = start.elapsed().as_secs_f64();
     summary.timings = timings;
@@ -815,7 +825,8 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
                 }
             })
             .collect(),
-        gripping_vertex: Some(model.gripping),
+        // The vertex name (1-based), as in the rule sequence and the record.
+        gripping_vertex: Some(model.plan.vertices[model.gripping].name),
         objective: Some(rec.objective),
         targets: model
             .targets
@@ -839,8 +850,9 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
     }
 }
 
-/// Write `designs/<id>.json` for every feasible design and, with export, its files and
-/// the report.
+/// Write `designs/<id>.json` for every feasible design, with export its files, and the
+/// report (always: its 3D views need only the geometry).
+#[allow(clippy::too_many_arguments)]
 fn write_designs(
     task: &Task,
     plan: &Plan,
@@ -849,6 +861,7 @@ fn write_designs(
     summary: &Summary,
     opts: &SearchOptions,
     out_dir: &OutputDir,
+    progress: &Progress,
 ) -> Result<(), SearchError> {
     // The earlier run's designs were deleted when the directory was opened (only the
     // files its manifest lists).
@@ -913,12 +926,8 @@ fn write_designs(
             "meta": meta,
         });
         Ok(DesignWork {
-            title: format!(
-                "{} — candidate {} — {}",
-                rec.sequence,
-                rec.candidate,
-                rec.modes.join(", ")
-            ),
+            rec: rec.clone(),
+            threshold: model.threshold,
             doc: serde_json::to_string_pretty(&doc).unwrap_or_default(),
             options: ExportOptions {
                 name: id.clone(),
@@ -929,7 +938,7 @@ fn write_designs(
             meta,
         })
     };
-    let write_one = |w: DesignWork| -> Result<Option<export::report::ReportDesign>, SearchError> {
+    let write_one = |w: DesignWork| -> Result<export::report::ReportDesign, SearchError> {
         let id = &w.id;
         let path = out_dir.path(&format!("designs/{id}.json"));
         std::fs::write(&path, &w.doc).map_err(|source| SearchError::Io {
@@ -937,7 +946,16 @@ fn write_designs(
             source,
         })?;
         if !opts.export {
-            return Ok(None);
+            progress.inc(1);
+            return Ok(report_design(
+                &w.rec,
+                w.threshold,
+                w.pattern,
+                w.meta,
+                path,
+                None,
+                None,
+            ));
         }
         let out = out_dir.path(&format!("designs/{id}"));
         let files = export::write_all(&out, &w.pattern, &w.meta, &w.options)
@@ -947,17 +965,30 @@ fn write_designs(
         if !check.ok {
             eprintln!("BUG: the exported FOLD file of {id} fails verification");
         }
-        Ok(Some(export::report::ReportDesign {
-            title: w.title,
-            meta: w.meta,
-            files,
-            verify: Some(check),
-        }))
+        progress.inc(1);
+        Ok(report_design(
+            &w.rec,
+            w.threshold,
+            w.pattern,
+            w.meta,
+            path,
+            Some(files),
+            Some(check),
+        ))
     };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
         .build()
         .map_err(|e| SearchError::Export(e.to_string()))?;
+    progress.phase(
+        if opts.export {
+            "write designs and their files"
+        } else {
+            "write design JSONs"
+        },
+        "designs",
+        Some(feasible.len() as u64),
+    );
     let mut cards: Vec<export::report::ReportDesign> = Vec::new();
     for chunk in feasible.chunks(256) {
         let recs = read_at(records, chunk)?;
@@ -979,135 +1010,32 @@ fn write_designs(
                 .map(write_one)
                 .collect::<Result<Vec<_>, _>>()
         })?;
-        cards.extend(written.into_iter().flatten());
+        cards.extend(written);
     }
-    if opts.export {
-        let input = report_input(task, plan, summary, cards);
-        out_dir.register([out_dir.path("report.html")])?;
-        export::report::write_report(out_dir.root(), &input)
-            .map_err(|e| SearchError::Export(e.to_string()))?;
-    }
+    progress.phase("write report", "", None);
+    let input = report_input(
+        task,
+        plan.tree.clone(),
+        summary,
+        task_facts(task, opts, summary),
+        cards,
+    );
+    out_dir.register([out_dir.path("report.html")])?;
+    let path = export::report::write_report(out_dir.root(), &input)
+        .map_err(|e| SearchError::Export(e.to_string()))?;
+    let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    progress.finish_phase_with(&format!("{} ({bytes} bytes)", path.display()));
     Ok(())
 }
 
 /// One design, built and ready to write.
 struct DesignWork {
     id: String,
-    title: String,
+    rec: AlternativeRecord,
+    threshold: f64,
     /// `designs/<id>.json`.
     doc: String,
     pattern: Pattern,
     meta: DesignMeta,
     options: ExportOptions,
-}
-
-/// The report's content.
-fn report_input(
-    task: &Task,
-    plan: &Plan,
-    s: &Summary,
-    designs: Vec<export::report::ReportDesign>,
-) -> export::report::ReportInput {
-    use export::plots::{DistributionPlot, Series};
-    use export::report::{CountRow, ReportInput, ReportSummary, TimingRow};
-    let th = |i: usize| s.thesis.map(|t| t[i] as u64);
-    let counts = vec![
-        CountRow {
-            label: "meaningful graphs".into(),
-            value: s.graphs as u64,
-            thesis: s.thesis.map(|_| 52),
-        },
-        CountRow {
-            label: "alternatives evaluated".into(),
-            value: s.alternatives as u64,
-            thesis: th(0),
-        },
-        CountRow {
-            label: "meet the target".into(),
-            value: s.meets_target as u64,
-            thesis: th(1),
-        },
-        CountRow {
-            label: "… free of self-intersection".into(),
-            value: s.no_self_intersection as u64,
-            thesis: th(2),
-        },
-        CountRow {
-            label: "… also clear of the obstacles".into(),
-            value: s.no_intersection as u64,
-            thesis: th(3),
-        },
-        CountRow {
-            label: "… also rigid over the whole motion".into(),
-            value: s.feasible as u64,
-            thesis: None,
-        },
-        CountRow {
-            label: "rigid at t_max only (thesis check passes, full motion fails)".into(),
-            value: s.rigid_at_tmax_only as u64,
-            thesis: None,
-        },
-        CountRow {
-            label: "verification failures".into(),
-            value: s.verification_failures as u64,
-            thesis: None,
-        },
-    ];
-    let t = &s.timings;
-    let timings = vec![
-        TimingRow {
-            stage: "enumerate (wall)".into(),
-            seconds: t.enumerate_s,
-        },
-        TimingRow {
-            stage: "compile (CPU)".into(),
-            seconds: t.compile_s,
-        },
-        TimingRow {
-            stage: "optimize (CPU)".into(),
-            seconds: t.optimize_s,
-        },
-        TimingRow {
-            stage: "check + verify (CPU)".into(),
-            seconds: t.check_s,
-        },
-    ];
-    let tree = plan.tree.clone();
-    let series = |name: &str, f: &dyn Fn(&super::record::LevelCounts) -> usize| Series {
-        name: name.into(),
-        points: s
-            .levels
-            .iter()
-            .map(|l| [l.level as f64, f(l) as f64])
-            .collect(),
-    };
-    let distribution = DistributionPlot {
-        title: format!(
-            "{}: designs over rule applications (thesis Fig. 51)",
-            task.name
-        ),
-        x_label: "rule applications".into(),
-        y_label: "designs".into(),
-        series: vec![
-            series("all", &|l| l.alternatives),
-            series("meet the target", &|l| l.meets_target),
-            series("no self-intersection", &|l| l.no_self_intersection),
-            series("no intersection", &|l| l.no_intersection),
-        ],
-    };
-    ReportInput {
-        summary: ReportSummary {
-            title: format!("foldsynth — {}", task.name),
-            task: task.name.clone(),
-            counts,
-            timings,
-            notes: vec![format!(
-                "{} starting points per alternative, seed {}, {} workers; the search took {:.1} s wall before writing these files.",
-                s.settings["starts"], s.settings["seed"], s.settings["jobs"], t.total_s
-            )],
-        },
-        tree,
-        distribution: Some(distribution),
-        designs,
-    }
 }

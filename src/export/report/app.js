@@ -1,0 +1,471 @@
+// report.html's script: sorts and filters the design table, and shows the selected design
+// as a three.js view of its folding motion beside its crease pattern. Everything it draws
+// comes from the JSON in #foldsynth-data (written by src/export/report/mod.rs); three.js
+// is the global FoldsynthThree (vendor/three/three.bundle.min.js, inlined before this).
+(function () {
+  'use strict';
+
+  const data = JSON.parse(document.getElementById('foldsynth-data').textContent);
+  const table = document.getElementById('design-table');
+  if (!table) return; // no feasible designs: nothing to show
+  const byId = new Map(data.designs.map((d) => [d.id, d]));
+  const tbody = table.tBodies[0];
+  const rows = Array.from(tbody.rows);
+  const heads = Array.from(table.tHead.rows[0].cells);
+  const state = { selected: null, frame: 0, playing: false, webgl: false, sort: null };
+  // Read-only view of the page's state, for people poking around in the console.
+  window.foldsynthReport = {
+    get selected() { return state.selected; },
+    get frame() { return state.frame; },
+    get webgl() { return state.webgl; },
+    get sort() { return state.sort; },
+  };
+
+  // ---- table: sorting -------------------------------------------------------------------
+  function sortValue(row, key, numeric) {
+    const v = row.querySelector('td[data-key="' + key + '"]').dataset.v;
+    if (v === '') return null;
+    return numeric ? Number(v) : v;
+  }
+
+  // Stable: equal values keep the search's order; missing values go last either way.
+  function sortBy(key, dir) {
+    const th = heads.find((h) => h.dataset.key === key);
+    if (!th) return;
+    const numeric = th.dataset.numeric === 'true';
+    const keyed = rows.map((r, i) => [sortValue(r, key, numeric), i, r]);
+    keyed.sort((a, b) => {
+      if (a[0] === null || b[0] === null) {
+        if (a[0] === b[0]) return a[1] - b[1];
+        return a[0] === null ? 1 : -1;
+      }
+      const c = numeric
+        ? a[0] - b[0]
+        : a[0].localeCompare(b[0], 'en', { numeric: true });
+      return c !== 0 ? dir * c : a[1] - b[1];
+    });
+    for (const k of keyed) tbody.appendChild(k[2]);
+    for (const h of heads) {
+      h.setAttribute('aria-sort', h === th ? (dir > 0 ? 'ascending' : 'descending') : 'none');
+    }
+    state.sort = { key: key, dir: dir };
+  }
+
+  for (const th of heads) {
+    const go = () => {
+      const same = state.sort && state.sort.key === th.dataset.key;
+      sortBy(th.dataset.key, same ? -state.sort.dir : 1);
+    };
+    th.addEventListener('click', go);
+    th.addEventListener('keydown', (e) => {
+      if (e.key === 'Enter' || e.key === ' ') {
+        e.preventDefault();
+        go();
+      }
+    });
+  }
+
+  // ---- table: filtering -----------------------------------------------------------------
+  const filters = Array.from(table.tHead.querySelectorAll('[data-filter]'));
+  const shownEl = document.getElementById('shown');
+
+  function passes(row, f) {
+    const td = row.querySelector('td[data-key="' + f.key + '"]');
+    if (f.kind === 'text') return td.textContent.toLowerCase().includes(f.value.toLowerCase());
+    if (f.kind === 'choice') return td.textContent === f.value;
+    if (td.dataset.v === '') return false;
+    const v = Number(td.dataset.v);
+    return f.kind === 'max' ? v <= f.limit : v >= f.limit;
+  }
+
+  function applyFilters() {
+    const active = [];
+    for (const el of filters) {
+      const value = el.value.trim();
+      el.classList.remove('invalid');
+      if (value === '') continue;
+      const f = { key: el.dataset.key, kind: el.dataset.filter, value: value };
+      if (f.kind === 'max' || f.kind === 'min') {
+        f.limit = Number(value);
+        if (!Number.isFinite(f.limit)) {
+          el.classList.add('invalid');
+          el.title = 'not a number: ignored';
+          continue;
+        }
+      }
+      active.push(f);
+    }
+    let shown = 0;
+    for (const r of rows) {
+      const ok = active.every((f) => passes(r, f));
+      r.hidden = !ok;
+      if (ok) shown += 1;
+    }
+    shownEl.textContent = String(shown);
+  }
+  for (const el of filters) {
+    el.addEventListener('input', applyFilters);
+    el.addEventListener('change', applyFilters);
+    el.addEventListener('click', (e) => e.stopPropagation());
+  }
+
+  // ---- the selected design ----------------------------------------------------------------
+  for (const r of rows) {
+    r.addEventListener('click', () => select(r.dataset.id));
+    r.addEventListener('keydown', (e) => {
+      if (e.key === 'Enter') select(r.dataset.id);
+    });
+  }
+
+  function el(tag, attrs, text) {
+    const e = document.createElement(tag);
+    for (const k in attrs || {}) e.setAttribute(k, attrs[k]);
+    if (text !== undefined) e.textContent = text;
+    return e;
+  }
+
+  function select(id) {
+    const d = byId.get(id);
+    if (!d) return;
+    state.selected = id;
+    for (const r of rows) r.classList.toggle('selected', r.dataset.id === id);
+    const parts = [d.id, d.sequence];
+    if (d.candidate !== null) parts.push('candidate ' + d.candidate);
+    if (d.modes !== '–') parts.push(d.modes);
+    document.getElementById('detail-title').textContent = parts.join(' — ');
+    const facts = document.getElementById('detail-facts').tBodies[0];
+    facts.replaceChildren();
+    const robust = d.robustness ? robustnessFacts(d.robustness) : [];
+    for (const [k, v] of [['id', d.id]].concat(d.facts, robust)) {
+      const tr = el('tr');
+      tr.appendChild(el('th', {}, k));
+      tr.appendChild(el('td', {}, v));
+      facts.appendChild(tr);
+    }
+    const files = document.getElementById('detail-files');
+    files.replaceChildren();
+    if (d.files.length) {
+      files.appendChild(document.createTextNode('files (in the run\u2019s output folder): '));
+      for (const [name, href] of d.files) files.appendChild(el('a', { href: href }, name));
+    } else {
+      files.textContent = 'no per-design files were written (--no-export)';
+    }
+    drawCreasePattern(d);
+    if (view) view.show(d);
+    setFrame(d.geometry.frames.length ? d.geometry.frames.length - 1 : 0);
+  }
+
+  function robustnessFacts(r) {
+    const out = [];
+    if (typeof r.score === 'number') out.push(['robustness score', fmt(r.score)]);
+    const names = {
+      rigid_margin: 'rigid margin',
+      self_clearance: 'self clearance',
+      arm_clearance: 'arm clearance',
+      obstacle_clearance: 'obstacle clearance',
+      min_feature: 'min feature',
+    };
+    for (const key in names) {
+      const m = r[key];
+      if (!m || typeof m.value !== 'number') continue;
+      let text = fmt(m.value) + ' (setting ' + fmt(m.setting) + ')';
+      if (typeof m.t === 'number') text += ' at t = ' + m.t.toFixed(4);
+      if (m.where) text += ', ' + m.where;
+      out.push([names[key], text]);
+    }
+    return out;
+  }
+
+  function fmt(x) {
+    if (typeof x !== 'number') return '–';
+    if (x === 0) return '0';
+    const a = Math.abs(x);
+    return a >= 1e-3 && a < 1e4 ? x.toPrecision(4) : x.toExponential(3);
+  }
+
+  // ---- crease pattern (SVG) ---------------------------------------------------------------
+  const SVG = 'http://www.w3.org/2000/svg';
+  const CP_COLORS = { B: '#000000', M: '#d62728', V: '#1f5fd6', F: '#9a9a9a' };
+
+  function svgEl(tag, attrs, text) {
+    const e = document.createElementNS(SVG, tag);
+    for (const k in attrs) e.setAttribute(k, attrs[k]);
+    if (text !== undefined) e.textContent = text;
+    return e;
+  }
+
+  function drawCreasePattern(d) {
+    const svg = document.getElementById('cp');
+    svg.replaceChildren();
+    const g = d.geometry;
+    const xs = g.flat.map((p) => p[0]);
+    const ys = g.flat.map((p) => -p[1]); // SVG's y points down
+    const minX = Math.min(...xs), maxX = Math.max(...xs);
+    const minY = Math.min(...ys), maxY = Math.max(...ys);
+    const size = Math.max(maxX - minX, maxY - minY, 1e-9);
+    const pad = 0.08 * size;
+    svg.setAttribute('viewBox', [minX - pad, minY - pad, maxX - minX + 2 * pad, maxY - minY + 2 * pad].join(' '));
+    const pt = (i) => [g.flat[i][0], -g.flat[i][1]];
+    for (let k = 0; k < g.tris.length; k += 3) {
+      const pts = [g.tris[k], g.tris[k + 1], g.tris[k + 2]].map((i) => pt(i).join(',')).join(' ');
+      svg.appendChild(svgEl('polygon', { points: pts, fill: '#fbf1e1', stroke: '#fbf1e1', 'stroke-width': 0.002 * size }));
+    }
+    g.edges.forEach((e, i) => {
+      const a = pt(e[0]), b = pt(e[1]);
+      svg.appendChild(svgEl('line', {
+        x1: a[0], y1: a[1], x2: b[0], y2: b[1],
+        stroke: CP_COLORS[g.assign[i]] || '#000000',
+        'stroke-width': (g.driven.includes(i) ? 0.018 : 0.008) * size,
+        'stroke-linecap': 'round',
+        'data-assignment': g.assign[i],
+      }));
+    });
+    const fs = 0.045 * size;
+    g.flat.forEach((p, i) => {
+      svg.appendChild(svgEl('text', { x: p[0] + 0.3 * fs, y: -p[1] - 0.3 * fs, 'font-size': fs, fill: '#444444', 'font-family': 'sans-serif' }, 'v' + (i + 1)));
+    });
+    if (d.gripping) {
+      const a = pt(d.gripping - 1);
+      svg.appendChild(svgEl('circle', { cx: a[0], cy: a[1], r: 0.03 * size, fill: 'none', stroke: '#000000', 'stroke-width': 0.008 * size }));
+    }
+  }
+
+  // ---- 3D view (three.js) ------------------------------------------------------------------
+  const slider = document.getElementById('t-slider');
+  const tOut = document.getElementById('t-value');
+  const playBtn = document.getElementById('play');
+  const view = makeView();
+  state.webgl = view !== null;
+
+  function hasWebGL() {
+    try {
+      const c = document.createElement('canvas');
+      return !!(c.getContext('webgl2') || c.getContext('webgl'));
+    } catch (e) {
+      return false;
+    }
+  }
+
+  function makeView() {
+    const T = window.FoldsynthThree;
+    const canvas = document.getElementById('canvas3d');
+    if (!T || !hasWebGL()) {
+      canvas.hidden = true;
+      document.getElementById('no-webgl').hidden = false;
+      return null;
+    }
+    const renderer = new T.WebGLRenderer({ canvas: canvas, antialias: true, preserveDrawingBuffer: true });
+    renderer.setPixelRatio(window.devicePixelRatio || 1);
+    const scene = new T.Scene();
+    scene.background = new T.Color(0xf4f4f2);
+    const camera = new T.PerspectiveCamera(35, 4 / 3, 0.01, 1000);
+    camera.up.set(0, 0, 1); // the task's z is up
+    scene.add(new T.AmbientLight(0xffffff, 1.3));
+    const light = new T.DirectionalLight(0xffffff, 2.2);
+    light.position.set(0.5, 0.8, 1.0); // relative to the camera: lit from where one looks
+    camera.add(light);
+    scene.add(camera);
+    const controls = new T.OrbitControls(camera, canvas);
+    controls.addEventListener('change', render);
+    let content = null;
+    let current = null; // per-design buffers updated for every t
+
+    function render() {
+      renderer.render(scene, camera);
+    }
+
+    function resize() {
+      const w = canvas.clientWidth, h = canvas.clientHeight;
+      if (!w || !h) return;
+      renderer.setSize(w, h, false);
+      camera.aspect = w / h;
+      camera.updateProjectionMatrix();
+      render();
+    }
+    new ResizeObserver(resize).observe(canvas);
+
+    function dispose(obj) {
+      obj.traverse((o) => {
+        if (o.geometry) o.geometry.dispose();
+        if (o.material) o.material.dispose();
+      });
+    }
+
+    function lineGeometry(points) {
+      const g = new T.BufferGeometry();
+      g.setAttribute('position', new T.BufferAttribute(new Float32Array(points.flat()), 3));
+      return g;
+    }
+
+    function show(d) {
+      if (content) {
+        scene.remove(content);
+        dispose(content);
+      }
+      content = new T.Group();
+      const g = d.geometry;
+      const n = g.flat.length;
+      const frames = g.frames.length ? g.frames : [g.flat.flatMap((p) => [p[0], p[1], 0])];
+      // Facets: one vertex per triangle corner, so every facet gets its own flat normal.
+      const faceGeo = new T.BufferGeometry();
+      faceGeo.setAttribute('position', new T.BufferAttribute(new Float32Array(g.tris.length * 3), 3));
+      const edgeGeo = new T.BufferGeometry();
+      edgeGeo.setAttribute('position', new T.BufferAttribute(new Float32Array(g.edges.length * 6), 3));
+      const colors = new Float32Array(g.edges.length * 6);
+      const EDGE = { B: 0x222222, M: 0xd62728, V: 0x1f5fd6, F: 0x9a9a9a };
+      g.edges.forEach((e, i) => {
+        const c = new T.Color(EDGE[g.assign[i]] || 0x222222);
+        colors.set([c.r, c.g, c.b, c.r, c.g, c.b], 6 * i);
+      });
+      edgeGeo.setAttribute('color', new T.BufferAttribute(colors, 3));
+      const offset = { polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 };
+      const arm = (front, back, lines) => {
+        const group = new T.Group();
+        const a = new T.Mesh(faceGeo, new T.MeshLambertMaterial(Object.assign({ color: front, side: T.FrontSide }, offset)));
+        const b = new T.Mesh(faceGeo, new T.MeshLambertMaterial(Object.assign({ color: back, side: T.BackSide }, offset)));
+        const l = new T.LineSegments(edgeGeo, new T.LineBasicMaterial({ vertexColors: true, transparent: lines < 1, opacity: lines }));
+        for (const o of [a, b, l]) {
+          o.frustumCulled = false; // the bounds change with t
+          group.add(o);
+        }
+        return group;
+      };
+      content.add(arm(0xf0a860, 0x7fa7d9, 1));
+      if (d.second_arm) {
+        const second = arm(0xf7d2ad, 0xbcd0ea, 0.45);
+        second.rotation.z = Math.PI; // the thesis's two-armed gripper: the arm rotated 180° about z
+        content.add(second);
+      }
+      // Everything the view should frame: every frame of both arms, targets, obstacle.
+      const pts = [];
+      for (const f of frames) {
+        for (let i = 0; i < n; i += 1) {
+          pts.push([f[3 * i], f[3 * i + 1], f[3 * i + 2]]);
+          if (d.second_arm) pts.push([-f[3 * i], -f[3 * i + 1], f[3 * i + 2]]);
+        }
+      }
+      for (const p of d.targets.concat(d.trajectory)) pts.push(p);
+      if (d.obstacle) pts.push(d.obstacle.a, d.obstacle.b);
+      const lo = [0, 1, 2].map((k) => Math.min(...pts.map((p) => p[k])));
+      const hi = [0, 1, 2].map((k) => Math.max(...pts.map((p) => p[k])));
+      const center = new T.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+      const radius = Math.max(1e-6, 0.5 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]));
+      const dot = (r, color) => new T.Mesh(new T.SphereGeometry(r, 20, 14), new T.MeshLambertMaterial({ color: color }));
+      for (const p of d.targets) {
+        const s = dot(0.03 * radius, 0x2e8b57);
+        s.position.set(p[0], p[1], p[2]);
+        content.add(s);
+      }
+      if (d.trajectory.length > 1) {
+        content.add(new T.Line(lineGeometry(d.trajectory), new T.LineBasicMaterial({ color: 0x2e8b57 })));
+      }
+      let marker = null;
+      const gv = d.gripping ? d.gripping - 1 : -1;
+      if (gv >= 0 && gv < n) {
+        const path = frames.map((f) => [f[3 * gv], f[3 * gv + 1], f[3 * gv + 2]]);
+        if (path.length > 1) content.add(new T.Line(lineGeometry(path), new T.LineBasicMaterial({ color: 0x333333 })));
+        marker = dot(0.022 * radius, 0x111111);
+        content.add(marker);
+      }
+      if (d.obstacle) {
+        const a = new T.Vector3().fromArray(d.obstacle.a);
+        const b = new T.Vector3().fromArray(d.obstacle.b);
+        const axis = b.clone().sub(a);
+        const cyl = new T.Mesh(
+          new T.CylinderGeometry(d.obstacle.radius, d.obstacle.radius, axis.length(), 48, 1, false),
+          new T.MeshLambertMaterial({ color: 0x8a8a8a, transparent: true, opacity: 0.35, depthWrite: false })
+        );
+        cyl.position.copy(a.clone().add(b).multiplyScalar(0.5));
+        cyl.quaternion.setFromUnitVectors(new T.Vector3(0, 1, 0), axis.normalize());
+        content.add(cyl);
+      }
+      scene.add(content);
+      current = { d: d, frames: frames, faceGeo: faceGeo, edgeGeo: edgeGeo, marker: marker, gv: gv, n: n };
+      // Front, right, above: the folded arm and its target in view.
+      const dir = new T.Vector3(0.55, -1.0, 0.6).normalize();
+      const dist = (radius / Math.sin((camera.fov * Math.PI) / 360)) * 0.9;
+      camera.position.copy(center.clone().add(dir.multiplyScalar(dist)));
+      camera.near = dist / 100;
+      camera.far = dist * 10;
+      camera.updateProjectionMatrix();
+      controls.target.copy(center);
+      controls.update();
+    }
+
+    // Vertex positions at fractional frame x: linear between the two nearest frames (each
+    // is an exact state of the rigid motion; the frames are dense enough to look smooth).
+    function setFrame(x) {
+      if (!current) return;
+      const fr = current.frames;
+      const i = Math.min(Math.floor(x), fr.length - 1);
+      const j = Math.min(i + 1, fr.length - 1);
+      const w = x - i;
+      const a = fr[i], b = fr[j];
+      const at = (v, k) => a[3 * v + k] * (1 - w) + b[3 * v + k] * w;
+      const tris = current.d.geometry.tris;
+      const fp = current.faceGeo.attributes.position;
+      for (let k = 0; k < tris.length; k += 1) fp.setXYZ(k, at(tris[k], 0), at(tris[k], 1), at(tris[k], 2));
+      fp.needsUpdate = true;
+      current.faceGeo.computeVertexNormals();
+      const ep = current.edgeGeo.attributes.position;
+      current.d.geometry.edges.forEach((e, k) => {
+        ep.setXYZ(2 * k, at(e[0], 0), at(e[0], 1), at(e[0], 2));
+        ep.setXYZ(2 * k + 1, at(e[1], 0), at(e[1], 1), at(e[1], 2));
+      });
+      ep.needsUpdate = true;
+      if (current.marker) current.marker.position.set(at(current.gv, 0), at(current.gv, 1), at(current.gv, 2));
+      render();
+    }
+
+    return { show: show, setFrame: setFrame };
+  }
+
+  function setFrame(x) {
+    const d = byId.get(state.selected);
+    if (!d) return;
+    const n = Math.max(d.geometry.frames.length, 1);
+    x = Math.min(Math.max(x, 0), n - 1);
+    state.frame = x;
+    slider.max = String(n - 1);
+    slider.value = String(x);
+    const ts = d.geometry.t;
+    let text = 'flat state';
+    if (ts.length) {
+      const i = Math.min(Math.floor(x), ts.length - 1);
+      const j = Math.min(i + 1, ts.length - 1);
+      const t = ts[i] + (ts[j] - ts[i]) * (x - i);
+      text = 't = ' + t.toFixed(4) + ' (' + ((t * 180) / Math.PI).toFixed(1) + '°)';
+    }
+    tOut.value = text;
+    tOut.textContent = text;
+    if (view) view.setFrame(x);
+  }
+
+  slider.addEventListener('input', () => setFrame(Number(slider.value)));
+
+  // Play: the whole motion in about 3 s, then again from the flat state.
+  let last = null;
+  function tick(now) {
+    if (!state.playing) return;
+    const d = byId.get(state.selected);
+    const n = d ? d.geometry.frames.length : 0;
+    if (n > 1 && last !== null) {
+      let x = state.frame + ((now - last) / 3000) * (n - 1);
+      if (x > n - 1) x = 0;
+      setFrame(x);
+    }
+    last = now;
+    requestAnimationFrame(tick);
+  }
+  playBtn.addEventListener('click', () => {
+    state.playing = !state.playing;
+    playBtn.textContent = state.playing ? 'pause' : 'play';
+    last = null;
+    if (state.playing) requestAnimationFrame(tick);
+  });
+
+  // Most robust first when the records carry robustness; otherwise the search's order.
+  if (heads.some((h) => h.dataset.key === 'score')) sortBy('score', -1);
+  applyFilters();
+  select(tbody.rows[0].dataset.id);
+})();

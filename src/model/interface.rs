@@ -1,0 +1,179 @@
+//! A compiled model as a C library (`foldsynth compile`): the names, bounds, parameters,
+//! output layout and prose that [`crate::compile::aot`] writes into the object, the
+//! header and the manifest.
+
+use super::Model;
+use super::compiled::{CompiledModel, objective_target};
+use crate::compile::aot::{self, Constant, Interface, Parameter, Variable};
+use crate::grammar::VarKind;
+use serde_json::{Value as Json, json};
+
+/// The interface of `compiled` (the model `model` of the task named `task`) under the
+/// symbol prefix `name`, with `modes` (±1 per internal vertex) as the default mode
+/// parameters.
+pub fn interface(
+    task: &str,
+    model: &Model,
+    compiled: &CompiledModel,
+    modes: &[f64],
+    name: &str,
+) -> Interface {
+    let (n, m) = (compiled.n_vars, compiled.n_constraints);
+    let up = name.to_ascii_uppercase();
+    let vars = model
+        .free
+        .iter()
+        .map(|&i| {
+            let (lower, upper) = model.var_bounds(i);
+            Variable {
+                name: model.plan.variables[i].name.clone(),
+                lower,
+                upper,
+            }
+        })
+        .collect();
+    let mut params: Vec<Parameter> = model
+        .plan
+        .internal
+        .iter()
+        .zip(modes)
+        .enumerate()
+        .map(|(k, (&v, &mode))| Parameter {
+            name: format!("M{}", k + 1),
+            doc: format!("mode of v{} (+1 up, -1 down)", model.plan.vertices[v].name),
+            default: mode,
+        })
+        .collect();
+    params.extend(model.times.iter().enumerate().map(|(k, &t)| Parameter {
+        name: format!("t{k}"),
+        doc: if k == 0 {
+            "the driving parameter at t_max (the constraints' state, and the target's if it is at t_max)".into()
+        } else {
+            "the driving parameter of a target state".into()
+        },
+        default: t,
+    }));
+    let mut outputs = vec!["objective".to_string()];
+    outputs.extend((0..m).map(|k| model.constraint_label(k)));
+    let objective = if model.targets.len() == 1 {
+        "w^2 * |X_g(t) - P|^2, the squared distance of the gripping vertex from its target"
+    } else {
+        "sum over the targets of w * sqrt(|X_g(t) - P|^2 + 1e-18) (Eq. 38)"
+    };
+    let doc = vec![
+        format!(
+            "The design model of the graph \"{}\" for task '{}', gripping vertex v{} (candidate {}).",
+            model.plan.sequence,
+            task,
+            model.plan.vertices[model.gripping].name,
+            model.candidate + 1
+        ),
+        String::new(),
+        format!("out[0] is the objective, {objective};"),
+        format!(
+            "the target is met when it is <= {:e} and every constraint is >= 0.",
+            objective_target(model)
+        ),
+        format!(
+            "out[1 + k] is constraint k (k < {up}_N_CONSTRAINTS), satisfied when >= 0 (thesis Eq. 31-35)."
+        ),
+        format!(
+            "The objective's gradient is out[{up}_GRADIENT_OFFSET + i], the constraints' Jacobian"
+        ),
+        format!("out[{up}_JACOBIAN_OFFSET + k * {up}_N_VARS + i] = d g_k / d vars[i]."),
+        "params holds the rigid-body modes of the internal vertices, then the values of t".into(),
+        "at which the model folds; NAME_default_params() gives those this library was made with."
+            .replace("NAME", name),
+    ];
+    let c = |name: &str, value: usize, doc: &str| Constant {
+        name: name.into(),
+        value,
+        doc: doc.into(),
+    };
+    let constants = vec![
+        c("n_constraints", m, "constraints g_k >= 0"),
+        c(
+            "n_modes",
+            model.plan.internal.len(),
+            "mode parameters: params[0 .. N_MODES)",
+        ),
+        c(
+            "n_times",
+            model.times.len(),
+            "time parameters: params[N_MODES .. N_PARAMS)",
+        ),
+        c("value_offset", 0, "out[VALUE_OFFSET]: the objective"),
+        c(
+            "constraints_offset",
+            1,
+            "out[CONSTRAINTS_OFFSET + k]: constraint k",
+        ),
+        c(
+            "gradient_offset",
+            1 + m,
+            "out[GRADIENT_OFFSET + i]: d objective / d vars[i]",
+        ),
+        c(
+            "jacobian_offset",
+            1 + m + n,
+            "out[JACOBIAN_OFFSET + k*N_VARS + i]: d g_k / d vars[i]",
+        ),
+    ];
+    Interface {
+        name: name.to_string(),
+        doc,
+        vars,
+        params,
+        outputs,
+        constants,
+    }
+}
+
+/// The manifest: [`aot::manifest`] plus a `model` object (task, graph, candidate,
+/// gripping vertex, modes, variables dropped from the optimization and their fixed
+/// values, threshold and target, expression counts).
+pub fn manifest(
+    task: &str,
+    model: &Model,
+    compiled: &CompiledModel,
+    modes: &[f64],
+    iface: &Interface,
+) -> Json {
+    let mut out = aot::manifest(iface, &compiled.compiled.layout);
+    let (n, m) = (compiled.n_vars, compiled.n_constraints);
+    let layout = &mut out["layout"];
+    layout["objective"] = json!({"offset": 0});
+    layout["constraints"] = json!({"offset": 1, "len": m});
+    layout["gradient"] = json!({"offset": 1 + m, "len": n});
+    layout["jacobian"] = json!({"offset": 1 + m + n, "rows": m, "cols": n, "order": "row-major"});
+    let rep = &compiled.compiled.report;
+    let dropped: Vec<Json> = model
+        .plan
+        .variables
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !model.free.contains(i))
+        .map(|(i, v)| json!({"name": v.name, "value": model.var_bounds(i).0}))
+        .collect();
+    out["model"] = json!({
+        "task": task,
+        "graph": model.plan.sequence,
+        "candidate": model.candidate + 1,
+        "gripping_vertex": model.plan.vertices[model.gripping].name,
+        "internal_vertices": model.plan.internal.iter().map(|&v| model.plan.vertices[v].name).collect::<Vec<_>>(),
+        "modes": modes.iter().map(|m| if *m > 0.0 { "up" } else { "down" }).collect::<Vec<_>>(),
+        "variable_kinds": model.free.iter().map(|&i| match model.plan.variables[i].kind {
+            VarKind::Sector => "sector",
+            VarKind::Length => "length",
+        }).collect::<Vec<_>>(),
+        "fixed_variables": dropped,
+        "times": model.times,
+        "t_max": model.t_max,
+        "targets": model.targets.iter().map(|t| json!({"t": t.t, "point": t.point, "weight": t.weight})).collect::<Vec<_>>(),
+        "threshold": model.threshold,
+        "objective_target": objective_target(model),
+        "n_constraints": compiled.n_constraints,
+        "counts": {"before": rep.input, "after": rep.simplified, "with_gradient": rep.with_gradients},
+    });
+    out
+}
