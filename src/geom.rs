@@ -63,6 +63,18 @@ pub fn dist(a: V3, b: V3) -> f64 {
     norm(sub(a, b))
 }
 
+/// The largest of `xs` (0 for none), NaN if any is NaN: `f64::max` would drop a NaN and
+/// let a failed comparison pass.
+pub fn max_or_nan(xs: impl IntoIterator<Item = f64>) -> f64 {
+    xs.into_iter().fold(0.0, |m: f64, x| {
+        if x.is_nan() || m.is_nan() {
+            f64::NAN
+        } else {
+            m.max(x)
+        }
+    })
+}
+
 /// a / |a|, or `None` for a zero vector.
 pub fn normalize(a: V3) -> Option<V3> {
     let n = norm(a);
@@ -218,10 +230,69 @@ pub fn faces_of_planar_graph(
         .collect())
 }
 
+/// The least-squares plane of a point set: through the centroid, normal along the
+/// covariance's eigenvector of the smallest eigenvalue (unit length, sign arbitrary).
+/// `None` for fewer than three points or points on one line or point.
+pub fn fit_plane(points: &[V3]) -> Option<(V3, V3)> {
+    if points.len() < 3 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let c = scale(points.iter().fold([0.0; 3], |a, &p| add(a, p)), 1.0 / n);
+    let mut m = nalgebra::Matrix3::<f64>::zeros();
+    for p in points {
+        let d = nalgebra::Vector3::from(sub(*p, c));
+        m += d * d.transpose();
+    }
+    if !m.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let eig = nalgebra::SymmetricEigen::new(m);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
+    // Points on a line (two vanishing eigenvalues) span no plane.
+    if eig.eigenvalues[order[1]] <= f64::EPSILON * eig.eigenvalues[order[2]].abs() {
+        return None;
+    }
+    let v = eig.eigenvectors.column(order[0]);
+    normalize([v[0], v[1], v[2]]).map(|nrm| (c, nrm))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::f64::consts::{FRAC_PI_2, PI};
+
+    #[test]
+    fn max_or_nan_keeps_a_nan() {
+        assert_eq!(super::max_or_nan([1.0, 3.0, 2.0]), 3.0);
+        assert!(super::max_or_nan([1.0, f64::NAN, 2.0]).is_nan());
+        // What f64::max would have said.
+        assert_eq!([1.0, f64::NAN, 2.0].into_iter().fold(0.0, f64::max), 2.0);
+        assert_eq!(super::max_or_nan(std::iter::empty()), 0.0);
+    }
+
+    #[test]
+    fn fit_plane_finds_a_tilted_plane() {
+        let n = super::normalize([1.0, -2.0, 2.0]).unwrap();
+        let (u, v) = ([2.0, 1.0, 0.0], [0.0, 1.0, 1.0]);
+        let pts: Vec<[f64; 3]> = (0..12)
+            .map(|k| {
+                let (a, b) = ((k % 4) as f64, (k / 4) as f64);
+                super::add(
+                    [0.5, 0.25, -1.0],
+                    super::add(super::scale(u, a), super::scale(v, b)),
+                )
+            })
+            .collect();
+        let (c, m) = super::fit_plane(&pts).unwrap();
+        assert!((super::dot(m, n).abs() - 1.0).abs() < 1e-12);
+        for p in &pts {
+            assert!(super::dot(super::sub(*p, c), m).abs() < 1e-12);
+        }
+        // Points on a line span no plane.
+        assert!(super::fit_plane(&[[0.0; 3], [1.0, 1.0, 1.0], [2.0, 2.0, 2.0]]).is_none());
+    }
 
     /// Square [0,2]×[−1,1] cut by the crease (0,0)→(2,0); left face y ≥ 0.
     fn two_faces(left_up: V3, right_up: V3) -> (Vec<V3>, Vec<V3>) {

@@ -11,9 +11,11 @@
 pub mod check;
 pub mod cli;
 pub mod compile;
+pub mod cpu_time;
 pub mod distribute;
 pub mod export;
 pub mod expr;
+pub mod fuzz;
 pub mod geom;
 pub mod grammar;
 pub mod kinematics;
@@ -25,3 +27,4 @@ pub mod search;
 pub mod simulate;
 pub mod task;
 pub mod text;
+pub mod trig;

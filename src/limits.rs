@@ -86,3 +86,40 @@ pub fn read_text(path: &std::path::Path) -> std::io::Result<String> {
     }
     std::fs::read_to_string(path)
 }
+
+/// Deepest nesting of parentheses in an expression or a vertex notation: recursive
+/// descent and evaluation need stack in proportion.
+pub const EXPR_DEPTH_MAX: usize = 64;
+/// Most operators and parentheses in one expression or vertex notation: the expression
+/// tree (evaluated and dropped recursively) stays shallow.
+pub const EXPR_OPS_MAX: usize = 1000;
+
+/// Check the size of an expression before parsing it: `Err((character position,
+/// message))` at the first excess.
+pub fn check_expression(text: &str) -> Result<(), (usize, String)> {
+    let (mut depth, mut ops) = (0usize, 0usize);
+    for (i, c) in text.chars().enumerate() {
+        match c {
+            '(' => {
+                depth += 1;
+                ops += 1;
+                if depth > EXPR_DEPTH_MAX {
+                    return Err((
+                        i,
+                        format!("parentheses nested deeper than {EXPR_DEPTH_MAX} levels"),
+                    ));
+                }
+            }
+            ')' => depth = depth.saturating_sub(1),
+            '+' | '-' | '*' | '/' | '^' => ops += 1,
+            _ => {}
+        }
+        if ops > EXPR_OPS_MAX {
+            return Err((
+                i,
+                format!("more than {EXPR_OPS_MAX} operators and parentheses"),
+            ));
+        }
+    }
+    Ok(())
+}

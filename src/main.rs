@@ -7,6 +7,14 @@ use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    // Symbolica (optional feature) prints a licence banner on stdout unless this is set;
+    // foldsynth prints its own notice on stderr instead (src/compile/symbolica/).
+    #[cfg(feature = "symbolica")]
+    if std::env::var_os("SYMBOLICA_HIDE_BANNER").is_none() {
+        // SAFETY: the first statement of main: no other thread exists yet that could read
+        // the environment concurrently.
+        unsafe { std::env::set_var("SYMBOLICA_HIDE_BANNER", "1") };
+    }
     let cli = match foldsynth::cli::Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) if e.use_stderr() => {

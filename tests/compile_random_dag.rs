@@ -1,8 +1,9 @@
 //! Random expression DAGs (proptest): the interpreter equals a direct f64 evaluation of
-//! the same program, the JIT equals the interpreter, and reverse-mode gradients equal
-//! forward-mode dual numbers.
+//! the same program, the JIT equals the interpreter (both compute the transcendentals with
+//! `foldsynth::trig`; the JIT in batches), and gradients by reverse sweeps and by vertex
+//! elimination equal forward-mode dual numbers.
 
-use foldsynth::compile::{CompiledFn, Dual, gradients};
+use foldsynth::compile::{CompiledFn, Dual, Jacobian, jacobian};
 use foldsynth::expr::{Ctx, NodeId, Sym, Tape, clamp_unit, select};
 use foldsynth::kinematics::Scalar;
 use proptest::prelude::*;
@@ -146,29 +147,31 @@ proptest! {
     }
 
     #[test]
-    fn reverse_mode_equals_dual_numbers(prog in program(), (x, p) in inputs()) {
+    fn gradients_equal_dual_numbers(prog in program(), (x, p) in inputs()) {
         prop_assume!(all_finite(&prog, &x, &p));
-        let (mut g, ids) = build(&prog);
-        let grads = gradients(&mut g, &ids, N_VARS).unwrap();
-        let flat: Vec<NodeId> = grads.iter().flatten().copied().collect();
-        let tape = Tape::new(&g, &flat, N_VARS, N_PARAMS).unwrap();
-        let mut r = vec![0.0; flat.len()];
-        tape.eval(&x, &p, &mut r).unwrap();
-        let dx: Vec<Dual> = (0..N_VARS).map(|i| Dual::var(x[i], i, N_VARS)).collect();
-        let dp: Vec<Dual> = p.iter().map(|&v| Dual::constant(v)).collect();
-        let d = run(&prog, &dx, &dp);
-        for (k, out) in d.iter().enumerate() {
-            if !out.v.is_finite() || out.g.iter().any(|v| !v.is_finite()) {
-                continue; // gradients of NaN values are not compared
-            }
-            let want = out.grad(N_VARS);
-            for i in 0..N_VARS {
-                let got = r[k * N_VARS + i];
-                let scale = got.abs().max(want[i].abs()).max(1.0);
-                prop_assert!(
-                    (got - want[i]).abs() <= 1e-10 * scale,
-                    "d out{k} / d x{i}: reverse {got} vs dual {}", want[i]
-                );
+        for method in [Jacobian::Reverse, Jacobian::Eliminate] {
+            let (mut g, ids) = build(&prog);
+            let grads = jacobian(&mut g, &ids, N_VARS, method).unwrap();
+            let flat: Vec<NodeId> = grads.iter().flatten().copied().collect();
+            let tape = Tape::new(&g, &flat, N_VARS, N_PARAMS).unwrap();
+            let mut r = vec![0.0; flat.len()];
+            tape.eval(&x, &p, &mut r).unwrap();
+            let dx: Vec<Dual> = (0..N_VARS).map(|i| Dual::var(x[i], i, N_VARS)).collect();
+            let dp: Vec<Dual> = p.iter().map(|&v| Dual::constant(v)).collect();
+            let d = run(&prog, &dx, &dp);
+            for (k, out) in d.iter().enumerate() {
+                if !out.v.is_finite() || out.g.iter().any(|v| !v.is_finite()) {
+                    continue; // gradients of NaN values are not compared
+                }
+                let want = out.grad(N_VARS);
+                for i in 0..N_VARS {
+                    let got = r[k * N_VARS + i];
+                    let scale = got.abs().max(want[i].abs()).max(1.0);
+                    prop_assert!(
+                        (got - want[i]).abs() <= 1e-10 * scale,
+                        "{method:?}: d out{k} / d x{i}: {got} vs dual {}", want[i]
+                    );
+                }
             }
         }
     }
@@ -178,20 +181,22 @@ proptest! {
         // Guarded derivatives: finite values never get a NaN gradient from sgn, acos
         // outside (-1, 1), sqrt at 0, atan2, clamp or select.
         prop_assume!(all_finite(&prog, &x, &p));
-        let (mut g, ids) = build(&prog);
-        let grads = gradients(&mut g, &ids, N_VARS).unwrap();
-        let tape_v = Tape::new(&g, &ids, N_VARS, N_PARAMS).unwrap();
-        let mut v = vec![0.0; ids.len()];
-        tape_v.eval(&x, &p, &mut v).unwrap();
-        let dx: Vec<Dual> = (0..N_VARS).map(|i| Dual::var(x[i], i, N_VARS)).collect();
-        let dp: Vec<Dual> = p.iter().map(|&q| Dual::constant(q)).collect();
-        let d = run(&prog, &dx, &dp);
-        for (k, grad) in grads.iter().enumerate() {
-            let tape = Tape::new(&g, grad, N_VARS, N_PARAMS).unwrap();
-            let mut r = vec![0.0; N_VARS];
-            tape.eval(&x, &p, &mut r).unwrap();
-            if v[k].is_finite() && d[k].g.iter().all(|q| q.is_finite()) {
-                prop_assert!(r.iter().all(|q| !q.is_nan()), "output {k}: {r:?}");
+        for method in [Jacobian::Reverse, Jacobian::Eliminate] {
+            let (mut g, ids) = build(&prog);
+            let grads = jacobian(&mut g, &ids, N_VARS, method).unwrap();
+            let tape_v = Tape::new(&g, &ids, N_VARS, N_PARAMS).unwrap();
+            let mut v = vec![0.0; ids.len()];
+            tape_v.eval(&x, &p, &mut v).unwrap();
+            let dx: Vec<Dual> = (0..N_VARS).map(|i| Dual::var(x[i], i, N_VARS)).collect();
+            let dp: Vec<Dual> = p.iter().map(|&q| Dual::constant(q)).collect();
+            let d = run(&prog, &dx, &dp);
+            for (k, grad) in grads.iter().enumerate() {
+                let tape = Tape::new(&g, grad, N_VARS, N_PARAMS).unwrap();
+                let mut r = vec![0.0; N_VARS];
+                tape.eval(&x, &p, &mut r).unwrap();
+                if v[k].is_finite() && d[k].g.iter().all(|q| q.is_finite()) {
+                    prop_assert!(r.iter().all(|q| !q.is_nan()), "{method:?} output {k}: {r:?}");
+                }
             }
         }
     }

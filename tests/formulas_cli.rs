@@ -2,7 +2,7 @@
 //! `python3` with NumPy, reproduces the interpreter's values; the other formats carry
 //! what they promise; bad input is an error, not a panic.
 
-use foldsynth::cli::formulas::{FormatArg, FormulasArgs, formulas};
+use foldsynth::cli::formulas::{Backend, FormatArg, FormulasArgs, formulas};
 use foldsynth::expr::{NodeId, Tape};
 use std::f64::consts::PI;
 use std::process::Command;
@@ -23,6 +23,8 @@ fn args(spec: &str, simplify: bool, gradient: bool, symbolic: bool) -> FormulasA
         simplify,
         gradient,
         symbolic_sectors: symbolic,
+        backend: Backend::Egg,
+        output: None,
     }
 }
 

@@ -444,3 +444,115 @@ fn unreadable_files_and_syntax_errors_are_reported() {
     let e = err(&edit("n_max = 3", "n_max = \"three\""));
     assert!(e.message.contains("line 3"), "{e}");
 }
+
+#[test]
+fn values_that_were_silently_accepted_are_refused() {
+    // Issue 13: a third coordinate was dropped, 1e308 made every objective NaN, a G0
+    // without an extendable vertex gave "0 meaningful graphs", a huge state count aborted.
+    let e = err(&edit("xy = [1.0, 0.0]", "xy = [1.0, 0.0, 2.0]"));
+    assert_err(
+        &e,
+        "initial_graph.vertices[1].xy",
+        &["3 values", "exactly 2"],
+    );
+    let e = err(&edit("xy = [1.0, 0.0]", "xy = [1.0]"));
+    assert_err(
+        &e,
+        "initial_graph.vertices[1].xy",
+        &["1 values", "exactly 2"],
+    );
+    let e = err(&edit("xy = [1.0, 0.0]", "xy = [1e308, 0.0]"));
+    assert_err(
+        &e,
+        "initial_graph.vertices[1].xy[0]",
+        &["1e308", "±1000000"],
+    );
+    // The echo of a 309-digit number is short.
+    assert!(e.to_string().len() < 300, "{e}");
+    let e = err(&edit("type = \"extendable\"", "type = \"terminal\""));
+    assert_err(&e, "initial_graph.vertices", &["extendable"]);
+    let e = err(&(BASE.to_owned() + "[check]\nstates = 1000000000\n"));
+    assert_err(&e, "check.states", &["at most 1000"]);
+    let e = err(&(BASE.to_owned()
+        + "[motion]\nt_max = 1\n[objective]\nthreshold = 1\n[[objective.targets]]\nt = 1\npoint = [0, 0]\n"));
+    assert_err(&e, "objective.targets[0].point", &["exactly 3"]);
+}
+
+#[test]
+fn a_task_name_is_a_safe_directory_name() {
+    for bad in ["../../victim", "/abs/path", "a/b", "..", ".", "x\\\\y"] {
+        let e = err(&format!("name = \"{bad}\"\n{BASE}"));
+        assert_err(&e, "name", &[]);
+    }
+    let e = err(&format!("name = \"{}\"\n{BASE}", "n".repeat(65)));
+    assert_err(&e, "name", &["64 characters"]);
+    let t =
+        Task::from_toml_str(&format!("name = \"{}\"\n{BASE}", "n".repeat(64)), "ok.toml").unwrap();
+    assert_eq!(t.name.len(), 64);
+    // The digest tells an edited file from the original.
+    let a = Task::from_toml_str(BASE, "a.toml").unwrap();
+    let b = Task::from_toml_str(&(BASE.to_owned() + "# edited\n"), "b.toml").unwrap();
+    assert_ne!(a.digest, b.digest);
+    assert_eq!(
+        a.digest,
+        Task::from_toml_str(BASE, "c.toml").unwrap().digest
+    );
+}
+
+#[test]
+fn robustness_defaults_and_settings() {
+    use foldsynth::task::{DEFAULT_CLEARANCE, DEFAULT_RIGID_MARGIN};
+    // Absent: 1° and 1% of G0's crease.
+    let t = Task::from_toml_str(BASE, "ok.toml").unwrap();
+    assert_eq!(t.robustness.rigid_margin, PI / 180.0);
+    assert_eq!(t.robustness.rigid_margin, DEFAULT_RIGID_MARGIN);
+    assert_eq!(t.robustness.clearance, DEFAULT_CLEARANCE);
+    assert_eq!(t.robustness.obstacle_clearance, 0.01);
+    // Given (expressions allowed), the others keep their defaults; zeros are allowed.
+    let t = Task::from_toml_str(
+        &(BASE.to_owned() + "[robustness]\nrigid_margin = \"pi/90\"\nclearance = 0\n"),
+        "ok.toml",
+    )
+    .unwrap();
+    assert_eq!(t.robustness.rigid_margin, PI / 90.0);
+    assert_eq!(t.robustness.clearance, 0.0);
+    assert_eq!(t.robustness.obstacle_clearance, DEFAULT_CLEARANCE);
+    // The optimizer's states default to 9.
+    let t = Task::from_toml_str(&(BASE.to_owned() + "[check]\nstates = 16\n"), "ok.toml").unwrap();
+    assert_eq!(t.check.unwrap().optimize_states, 9);
+}
+
+#[test]
+fn bad_robustness_values_are_refused_with_file_and_field() {
+    let with = |extra: &str| BASE.to_owned() + extra;
+    let e = err(&with("[robustness]\nrigid_margin = -0.1\n"));
+    assert_err(&e, "robustness.rigid_margin", &["-0.1", "≥ 0"]);
+    let e = err(&with("[robustness]\nclearance = nan\n"));
+    assert_err(&e, "robustness.clearance", &["not a finite number"]);
+    let e = err(&with("[robustness]\nobstacle_clearance = -1e-3\n"));
+    assert_err(&e, "robustness.obstacle_clearance", &["≥ 0"]);
+    let e = err(&with("[robustness]\nclearance = inf\n"));
+    assert_err(&e, "robustness.clearance", &["not a finite number"]);
+    // Larger than the pattern: G0's crease is 1 (the unit of lengths).
+    let e = err(&with("[robustness]\nclearance = 1.5\n"));
+    assert_err(
+        &e,
+        "robustness.clearance",
+        &["larger than the pattern", "[0, 1)"],
+    );
+    let e = err(&with("[robustness]\nobstacle_clearance = 2\n"));
+    assert_err(
+        &e,
+        "robustness.obstacle_clearance",
+        &["larger than the pattern"],
+    );
+    // No vertex triangle has an Eq. 25 margin of 2π/3 or more.
+    let e = err(&with("[robustness]\nrigid_margin = \"2*pi/3\"\n"));
+    assert_err(&e, "robustness.rigid_margin", &["2π/3"]);
+    let e = err(&with("[robustness]\nrigid_margin = \"pi/\"\n"));
+    assert_eq!(e.field, "robustness.rigid_margin");
+    let e = err(&with("[robustness]\nmargin = 1\n"));
+    assert!(e.message.contains("unknown field"), "{e}");
+    let e = err(&with("[check]\nstates = 16\noptimize_states = 1\n"));
+    assert_err(&e, "check.optimize_states", &["at least 2"]);
+}

@@ -180,11 +180,19 @@ fn hand_written_files_verify() {
 fn inconsistent_faces_are_reported() {
     let dir = tempfile::tempdir().unwrap();
     let cases = [
-        // Second face clockwise.
+        // Second face clockwise in a declared crease pattern.
+        (
+            r#"{"frame_classes": ["creasePattern"], "vertices_coords": [[0,0],[1,0],[1,1],[0,1]], "edges_vertices": [[0,1],[1,2],[2,3],[3,0],[1,3]],
+               "edges_assignment": ["B","B","B","B","V"], "faces_vertices": [[0,1,3],[1,3,2]]}"#,
+            "faces oriented",
+        ),
+        // The same without frame_classes: faces turned both ways may be a flat-folded
+        // state, so orientation is not held against it, but the two faces still run the
+        // same way along their shared edge (a combinatorial fact).
         (
             r#"{"vertices_coords": [[0,0],[1,0],[1,1],[0,1]], "edges_vertices": [[0,1],[1,2],[2,3],[3,0],[1,3]],
                "edges_assignment": ["B","B","B","B","V"], "faces_vertices": [[0,1,3],[1,3,2]]}"#,
-            "faces counter-clockwise",
+            "manifold",
         ),
         // A crease with a face on one side only.
         (
@@ -207,9 +215,11 @@ fn inconsistent_faces_are_reported() {
                "faces_vertices": [[0,1,3],[1,2,3]]}"#,
             "assignment vs fold angle",
         ),
-        // A flat key frame is required.
+        // A crease pattern must be planar (in any plane: one triangle always is, so two
+        // faces bent against each other).
         (
-            r#"{"vertices_coords": [[0,0,0],[1,0,0],[0,1,0.5]], "faces_vertices": [[0,1,2]]}"#,
+            r#"{"frame_classes": ["creasePattern"], "vertices_coords": [[0,0,0],[1,0,0],[1,1,0.5],[0,1,0]],
+               "faces_vertices": [[0,1,2],[0,2,3]]}"#,
             "flat crease pattern",
         ),
     ];

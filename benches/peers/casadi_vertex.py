@@ -105,6 +105,7 @@ def ptu_phi_sum(ca, sectors, driving, mode):
 
 
 HARNESS = r"""
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
@@ -124,7 +125,8 @@ static int cmp(const void* a, const void* b) {
 int main(int argc, char** argv) {
     int nx = atoi(argv[1]), np = atoi(argv[2]);
     double budget_ns = atof(argv[3]) * 1e6;
-    double x[64], p[8], fval, grad[64];
+    double *x = malloc(sizeof(double) * (nx + 1)), *p = malloc(sizeof(double) * (np + 1));
+    double fval, *grad = malloc(sizeof(double) * (nx + 1));
     for (int i = 0; i < nx; i++) x[i] = atof(argv[4 + i]);
     for (int i = 0; i < np; i++) p[i] = atof(argv[4 + nx + i]);
     casadi_int sz_arg, sz_res, sz_iw, sz_w;
@@ -150,8 +152,15 @@ int main(int argc, char** argv) {
         s[m++] = (now_ns() - t0) / n;
     }
     qsort(s, m, sizeof(double), cmp);
-    printf("{\"value_grad_ns\": %.3f, \"value\": %.17g, \"grad\": [", s[m / 2], fval);
-    for (int i = 0; i < nx; i++) printf("%s%.17g", i ? ", " : "", grad[i]);
+    /* JSON has no NaN: a non-finite value (CasADi's gradient outside the rigid interval)
+       is written as null. */
+    printf("{\"value_grad_ns\": %.3f, \"value\": ", s[m / 2]);
+    if (isfinite(fval)) printf("%.17g", fval); else printf("null");
+    printf(", \"grad\": [");
+    for (int i = 0; i < nx; i++) {
+        if (i) printf(", ");
+        if (isfinite(grad[i])) printf("%.17g", grad[i]); else printf("null");
+    }
     printf("]}\n");
     return 0;
 }

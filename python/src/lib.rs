@@ -172,8 +172,10 @@ impl Task {
     }
 
     /// Run the whole method (enumerate, optimize every alternative, check, verify,
-    /// export) into the directory `out`; returns the summary (as summary.json).
-    #[pyo3(signature = (out, *, jobs = 0, starts = 16, seed = 0, resume = false, n_max = None, sweep = 181, export = true))]
+    /// export) into the directory `out`; returns the summary (as summary.json). `out`
+    /// must be new, empty or a run of the same settings unless `force` (as the CLI's
+    /// `--force`); every count is checked against its limit (as the CLI).
+    #[pyo3(signature = (out, *, jobs = 0, starts = 16, seed = 0, resume = false, force = false, n_max = None, sweep = 181, export = true))]
     #[allow(clippy::too_many_arguments)]
     fn synthesize<'py>(
         &self,
@@ -183,6 +185,7 @@ impl Task {
         starts: usize,
         seed: u64,
         resume: bool,
+        force: bool,
         n_max: Option<usize>,
         sweep: usize,
         export: bool,
@@ -199,10 +202,13 @@ impl Task {
             starts,
             seed,
             resume,
+            force,
             n_max,
-            sweep: sweep.max(2),
+            sweep,
             export,
             progress: false,
+            // The thesis's rules (r1, r2); r2′ is the CLI's `--rules r1,r2,r2p`.
+            ..SearchOptions::default()
         };
         let task = &self.task;
         let summary = py.detach(|| search::run(task, &opts)).map_err(fs_err)?;

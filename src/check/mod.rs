@@ -4,9 +4,14 @@
 //! * [`tri_tri`] — Möller's triangle–triangle test with a contact tolerance;
 //! * [`self_intersection`] — facet pairs at one state: crossings and the flip test of
 //!   thesis Sec. 3.2.4;
+//! * [`features`] — feature size of the flat layout (vertex–vertex, vertex–edge, edge
+//!   lengths): what fabrication and importers that snap geometry need;
 //! * [`cylinder`] — the finite-cylinder obstacle of the gripper task (Sec. 5.5);
 //! * [`motion`] — the flat layout and evenly spaced states of a motion (16 in the thesis);
-//! * [`rotated_copy`] — the two-armed gripper built from one arm.
+//! * [`rotated_copy`] — the two-armed gripper built from one arm;
+//! * [`cycle`] — cyclic designs (r2′): compatibility and position agreement over a sweep.
+//! * [`robustness`] — margins of a motion (rigid margin, clearances) measured exactly,
+//!   independently of the optimizer's clearance constraints.
 //!
 //! ```
 //! use foldsynth::check::{Checker, MotionSettings, check_motion};
@@ -25,8 +30,11 @@
 //! assert!(!bad.self_intersection_free());
 //! ```
 
+pub mod cycle;
 pub mod cylinder;
+pub mod features;
 pub mod motion;
+pub mod robustness;
 pub mod rotated_copy;
 pub mod self_intersection;
 pub mod tri_tri;

@@ -5,8 +5,11 @@
 
 use crate::compile::vertex::{self, VertexModel};
 use crate::compile::{Dual, Options, compile};
+use crate::cpu_time::Stopwatch;
 use crate::expr::Tape;
+use crate::geom::max_or_nan;
 use crate::kinematics::VertexSpec;
+use crate::kinematics::foldability::{self, RIGID_TOL};
 use anyhow::{Context, Result, bail};
 use serde_json::json;
 use std::hint::black_box;
@@ -49,6 +52,9 @@ pub fn run(args: BenchArgs) -> Result<()> {
 pub enum Peer {
     /// CasADi SX, reverse-mode gradient, generated C compiled with `gcc -O3`.
     Casadi,
+    /// Symbolica: its canonical form, its derivatives, its optimized evaluator, SymJIT
+    /// (needs the `symbolica` cargo feature).
+    Symbolica,
 }
 
 /// Arguments of `foldsynth bench vertex`.
@@ -64,36 +70,42 @@ pub struct VertexBenchArgs {
     /// Print one JSON object (times in nanoseconds, compile times in milliseconds).
     #[arg(long)]
     pub json: bool,
-    /// Also run a peer implementation in this invocation.
-    #[arg(long, value_enum)]
-    pub peer: Option<Peer>,
+    /// Also run peer implementations in this invocation (repeat or separate by commas:
+    /// `--peer casadi,symbolica`).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub peer: Vec<Peer>,
     /// The driving parameter at which to evaluate (default: the most rigid sample of
     /// (0, π), away from singular states).
     #[arg(long, allow_hyphen_values = true)]
     pub t: Option<f64>,
     /// Milliseconds of measurement per row (split into rounds of batches; the fastest
     /// round's median batch is reported).
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u64).range(1..=crate::limits::BENCH_MILLIS_MAX))]
     pub millis: u64,
     /// The peer script (default: the crate's benches/peers/casadi_vertex.py).
     #[arg(long)]
     pub peer_script: Option<PathBuf>,
 }
 
-/// Median nanoseconds per call of `f`, over batches filling about `budget`.
+/// Median nanoseconds per call of `f`, over batches filling about `budget`: CPU time of
+/// this thread per batch (where the platform has a thread clock), so time the process
+/// spends waiting for a core on a busy machine does not count.
 pub(crate) fn time_ns(budget: Duration, mut f: impl FnMut()) -> f64 {
-    // Calibrate: how many calls take ~1/20 of the budget.
-    let target = budget / 20;
-    let mut n = 1usize;
-    loop {
-        let t = Instant::now();
+    let batch = |f: &mut dyn FnMut(), n: usize| {
+        let t = Stopwatch::start();
         for _ in 0..n {
             f();
         }
-        let e = t.elapsed();
-        if e >= target / 4 || n >= 1 << 30 {
-            let per = e.as_secs_f64() / n as f64;
-            n = ((target.as_secs_f64() / per.max(1e-10)) as usize).max(1);
+        t.cpu_ms() * 1e6
+    };
+    // Calibrate: how many calls take ~1/20 of the budget.
+    let target_ns = budget.as_secs_f64() * 1e9 / 20.0;
+    let mut n = 1usize;
+    loop {
+        let e = batch(&mut f, n);
+        if e >= target_ns / 4.0 || n >= 1 << 30 {
+            let per = e / n as f64;
+            n = ((target_ns / per.max(1e-1)) as usize).max(1);
             break;
         }
         n *= 4;
@@ -101,11 +113,7 @@ pub(crate) fn time_ns(budget: Duration, mut f: impl FnMut()) -> f64 {
     let mut samples = Vec::new();
     let start = Instant::now();
     while samples.len() < 5 || (start.elapsed() < budget && samples.len() < 41) {
-        let t = Instant::now();
-        for _ in 0..n {
-            f();
-        }
-        samples.push(t.elapsed().as_secs_f64() * 1e9 / n as f64);
+        samples.push(batch(&mut f, n) / n as f64);
     }
     samples.sort_by(f64::total_cmp);
     samples[samples.len() / 2]
@@ -133,8 +141,8 @@ fn rel(a: f64, b: f64) -> f64 {
 pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     let spec = VertexSpec::parse(&args.spec).context("invalid vertex")?;
     let t = args.t.unwrap_or_else(|| vertex::most_rigid_t(&spec));
-    if !t.is_finite() {
-        bail!("--t must be a finite number");
+    if !(t.is_finite() && t.abs() <= crate::limits::COORD_MAX) {
+        bail!("--t must be a finite number within ±1e6");
     }
     let sym = args.symbolic_sectors;
     let (vars, params) = vertex::point(&spec, sym, t);
@@ -193,19 +201,34 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     let fd = central(&vars);
     let grad: Vec<f64> = buf[compiled.layout.gradient(0)].to_vec();
     let value = buf[0];
-    let max_dev_dual = (0..n)
-        .map(|i| rel(grad[i], dual.g.get(i).copied().unwrap_or(0.0)))
-        .fold(0.0, f64::max);
-    let max_dev_fd = (0..n).map(|i| rel(grad[i], fd[i])).fold(0.0, f64::max);
+    let max_dev_dual =
+        max_or_nan((0..n).map(|i| rel(grad[i], dual.g.get(i).copied().unwrap_or(0.0))));
+    let max_dev_fd = max_or_nan((0..n).map(|i| rel(grad[i], fd[i])));
     let max_dev_value = rel(buf[0], f64_value).max(rel(buf[0], tbuf[0]));
 
     // Timings. Every row is measured in each of several rounds (the peer's harness too)
     // and the fastest round is reported: interference from other processes only ever
     // adds time, so the minimum is the most repeatable estimate on a busy machine, and
     // all rows are treated alike.
-    let peer_setup = match args.peer {
-        Some(Peer::Casadi) => Some(casadi_setup(&args, &spec, t)?),
-        None => None,
+    let peer_setup = if args.peer.contains(&Peer::Casadi) {
+        Some(casadi_setup(&args, &spec, t)?)
+    } else {
+        None
+    };
+    let mut symbolica = if args.peer.contains(&Peer::Symbolica) {
+        let job = super::bench_symbolica::PeerJob {
+            graph: graph.clone(),
+            outputs: vec![("phi_sum".to_string(), out[0])],
+            names: model.names.clone(),
+            n_vars: model.n_vars,
+            n_params: model.n_params,
+        };
+        let inputs: Vec<f64> = vars.iter().chain(&params).copied().collect();
+        Some(super::bench_symbolica::SymbolicaPeer::new(
+            job, inputs, &buf, 3,
+        )?)
+    } else {
+        None
     };
     let rounds: u32 = 7;
     let slice = budget / rounds;
@@ -264,6 +287,9 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
                 black_box(&dparams),
             ));
         }));
+        if let Some(s) = &mut symbolica {
+            s.round(slice)?;
+        }
         if let Some(PeerSetup::Harness { argv, .. }) = &peer_setup
             && harness_error.is_none()
         {
@@ -307,16 +333,48 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     };
 
     // The peer's own numbers against ours (the same function at the same point).
-    let peer_dev = peer.as_ref().and_then(|p| {
-        let v = p.get("value")?.as_f64()?;
-        let g = p.get("grad")?.as_array()?;
-        let mut d = rel(v, value);
-        for (i, gi) in g.iter().enumerate() {
-            // CasADi's gradient may be NaN where ours is guarded (sqrt at 0).
-            d = d.max(rel(gi.as_f64().unwrap_or(f64::NAN), grad[i]));
+    // `null` is the harness's NaN (JSON has none): CasADi's gradient is NaN outside the
+    // rigid interval, where ours is guarded (sqrt at 0). NaN stays NaN in the maximum.
+    let peer_nan = |p: &serde_json::Value| -> Vec<String> {
+        let mut out = Vec::new();
+        if p.get("value").is_some_and(|v| v.is_null()) {
+            out.push("value".to_string());
         }
-        Some(d)
+        if let Some(g) = p.get("grad").and_then(|g| g.as_array()) {
+            out.extend(
+                g.iter()
+                    .enumerate()
+                    .filter(|(_, x)| x.is_null())
+                    .map(|(i, _)| format!("grad[{i}]")),
+            );
+        }
+        out
+    };
+    let peer_nans = peer.as_ref().map(peer_nan).unwrap_or_default();
+    let peer_dev = peer.as_ref().and_then(|p| {
+        let v = p.get("value")?;
+        let g = p.get("grad")?.as_array()?;
+        let num = |x: &serde_json::Value| x.as_f64().unwrap_or(f64::NAN);
+        Some(max_or_nan(std::iter::once(rel(num(v), value)).chain(
+            g.iter().enumerate().map(|(i, gi)| rel(num(gi), grad[i])),
+        )))
     });
+    let rigid_here = foldability::min_margin(&spec, t) >= -RIGID_TOL;
+    // A NaN or a deviation where the vertex is rigid is a failed check (exit 1).
+    let verdict = || -> Result<()> {
+        match peer_dev {
+            Some(d) if rigid_here && (d.is_nan() || d > 1e-6) => Err(super::CheckFailed(format!(
+                "CasADi and foldsynth disagree at t = {t}, where the vertex is rigid: relative deviation {}",
+                if d.is_nan() {
+                    "NaN".to_string()
+                } else {
+                    format!("{d:.1e}")
+                }
+            ))
+            .into()),
+            _ => Ok(()),
+        }
+    };
 
     let ops_before = rep.input.ops;
     let ops_after = rep.simplified.ops;
@@ -364,10 +422,17 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
             if let Some(ms) = p.get("total_compile_ms").and_then(|v| v.as_f64()) {
                 o["peer_compile_ratio"] = json!(compile_ms / ms);
             }
-            o["peer_max_rel_dev"] = json!(peer_dev);
+            o["peer_max_rel_dev"] = json!(peer_dev.filter(|d| d.is_finite()));
+            o["peer_nan"] = json!(peer_nans);
+            o["rigid_at_t"] = json!(rigid_here);
+        }
+        if let Some(s) = &symbolica {
+            o["symbolica"] = s.json();
+            o["symbolica_value_grad_ratio"] = json!(jit_value_grad_ns / s.value_grad_ns());
+            o["symbolica_compile_ratio"] = json!(compile_ms / s.compile_ms());
         }
         println!("{}", serde_json::to_string_pretty(&o)?);
-        return Ok(());
+        return verdict();
     }
 
     println!(
@@ -409,6 +474,9 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
             println!("CasADi peer skipped: {msg}");
         }
     }
+    if let Some(s) = &symbolica {
+        row("Symbolica SymJIT (peer)", s.value_grad_ns());
+    }
     println!();
     println!("{:<44} {:>12.1}", "JIT value only (ns)", jit_value_ns);
     println!(
@@ -436,12 +504,26 @@ pub fn run_vertex(args: VertexBenchArgs) -> Result<()> {
     println!(
         "checks: value vs f64/interpreter {max_dev_value:.1e}, gradient vs dual {max_dev_dual:.1e}, vs central differences {max_dev_fd:.1e}"
     );
-    if let Some(d) = peer_dev {
-        println!(
-            "CasADi's value and gradient vs ours: {d:.1e} (NaN: CasADi's gradient is not guarded)"
-        );
+    match peer_dev {
+        Some(d) if d.is_finite() => println!("CasADi's value and gradient vs ours: {d:.1e}"),
+        Some(_) => println!(
+            "CasADi's value and gradient vs ours: not comparable, CasADi gives NaN for {} at t = {t}{}",
+            peer_nans.join(", "),
+            if rigid_here {
+                ""
+            } else {
+                " (outside the vertex's rigid interval: its sqrt of a negative number is NaN; ours is guarded)"
+            }
+        ),
+        None => {}
     }
-    Ok(())
+    if let Some(s) = &symbolica {
+        println!();
+        for l in s.lines(jit_value_grad_ns, compile_ms) {
+            println!("{l}");
+        }
+    }
+    verdict()
 }
 
 enum PeerSetup {

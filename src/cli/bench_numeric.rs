@@ -55,7 +55,7 @@ pub struct NumericBenchArgs {
     #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub steps: u64,
     /// Milliseconds of measurement per row.
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u64).range(1..=crate::limits::BENCH_MILLIS_MAX))]
     pub millis: u64,
     /// Print one JSON object (times in nanoseconds per motion).
     #[arg(long)]
@@ -134,7 +134,7 @@ fn mode_names(modes: &[f64]) -> String {
 
 /// Rebuild a design JSON's model from its task, sequence, candidate, modes and variables.
 fn from_design_file(path: &Path, task_flag: Option<&Path>) -> Result<Design> {
-    let text = std::fs::read_to_string(path)
+    let text = crate::limits::read_text(path)
         .with_context(|| format!("{}: cannot read", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("{}: not valid JSON", path.display()))?;

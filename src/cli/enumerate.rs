@@ -8,7 +8,9 @@ use std::io::{BufWriter, Write};
 use anyhow::Context;
 use serde::Serialize;
 
-use crate::grammar::{DOT_FOOTER, Enumeration, Filters, LevelCounts, Status, dot_header, dot_node};
+use crate::grammar::{
+    DOT_FOOTER, Enumeration, Filters, LevelCounts, Rules, Status, dot_header, dot_node,
+};
 use crate::limits::N_MAX;
 use crate::task::Task;
 
@@ -44,6 +46,9 @@ pub struct EnumerateArgs {
     /// Write the search tree (Fig. 48) as Graphviz DOT to this file.
     #[arg(long, value_name = "FILE.dot")]
     pub tree: Option<PathBuf>,
+    /// The grammar's rules: r1,r2 (the thesis's, default) or r1,r2,r2p (with r2′).
+    #[arg(long, default_value = "r1,r2", value_name = "RULES")]
+    pub rules: Rules,
 }
 
 #[derive(Serialize)]
@@ -56,12 +61,23 @@ struct GraphEntry {
     parent: Option<usize>,
     /// 2^N × 3 for meaningful graphs, else 0.
     alternatives: u64,
+    /// Closed a cycle by r2′ (only listed with r2′ enabled).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    cyclic: Option<bool>,
 }
 
 /// One meaningful graph for the text report.
 struct Meaningful {
     sequence: String,
     n: usize,
+    alternatives: u64,
+}
+
+/// With r2′: the cyclic share of the language.
+#[derive(Default, Serialize)]
+struct CyclicSummary {
+    generated: usize,
+    meaningful: usize,
     alternatives: u64,
 }
 
@@ -95,7 +111,9 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
     let mut meaningful: Vec<Meaningful> = Vec::new();
     let mut alternatives = 0u64;
     let mut failed: Option<std::io::Error> = None;
-    let streamed = Enumeration::stream(&task, n_max, filters, |g| {
+    let rules = args.rules;
+    let mut cyclic = CyclicSummary::default();
+    let streamed = Enumeration::stream_with(&task, n_max, filters, rules, |g| {
         LevelCounts::count(&mut levels, g.level, g.status);
         let alt = if g.status == Status::Meaningful {
             g.graph.alternatives()
@@ -103,6 +121,12 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
             0
         };
         alternatives += alt;
+        let is_cyclic = rules.r2p && g.graph.is_cyclic_pattern();
+        if is_cyclic {
+            cyclic.generated += 1;
+            cyclic.meaningful += usize::from(g.status == Status::Meaningful);
+            cyclic.alternatives += alt;
+        }
         if failed.is_some() {
             return;
         }
@@ -118,6 +142,7 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
                     status: g.status,
                     parent: g.parent,
                     alternatives: alt,
+                    cyclic: rules.r2p.then_some(is_cyclic),
                 };
                 let sep = if g.index == 0 { "" } else { "," };
                 write!(out, "{sep}\n    {}", serde_json::to_string(&entry)?)?;
@@ -144,7 +169,7 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
     }
     let total = |f: fn(&LevelCounts) -> usize| levels.iter().map(f).sum::<usize>();
     if json {
-        let tail = serde_json::json!({
+        let mut tail = serde_json::json!({
             "generated": streamed.generated,
             "filtered": {
                 "isomorphic": total(|c| c.isomorphic),
@@ -153,6 +178,10 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
             },
             "alternatives": alternatives,
         });
+        if rules.r2p {
+            tail["rules"] = serde_json::json!(rules.names());
+            tail["cyclic"] = serde_json::to_value(&cyclic)?;
+        }
         let tail = serde_json::to_string_pretty(&tail)?;
         // The totals' fields, after the graphs, in the same object.
         let fields = tail
@@ -171,6 +200,7 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
             &levels,
             &meaningful,
             alternatives,
+            rules.r2p.then_some(&cyclic),
         );
         out.write_all(report.as_bytes())?;
     }
@@ -192,6 +222,7 @@ fn text_report(
     levels: &[LevelCounts],
     meaningful: &[Meaningful],
     alternatives: u64,
+    cyclic: Option<&CyclicSummary>,
 ) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
@@ -214,6 +245,9 @@ fn text_report(
         mirror,
         on(filters.validity)
     );
+    if args.rules != Rules::default() {
+        let _ = writeln!(s, "rules: {}", args.rules.names().replace("r2p", "r2′"));
+    }
     let _ = writeln!(s);
     let _ = writeln!(
         s,
@@ -251,6 +285,13 @@ fn text_report(
         s,
         "design alternatives: {alternatives} (sum over meaningful graphs of 2^N RBM assignments x 3 gripping candidates)"
     );
+    if let Some(c) = cyclic {
+        let _ = writeln!(
+            s,
+            "cyclic graphs (closed by r2′): {} generated, {} meaningful, {} alternatives",
+            c.generated, c.meaningful, c.alternatives
+        );
+    }
     if let Some(t) = &args.tree {
         let _ = writeln!(s, "search tree written to {}", t.display());
     }

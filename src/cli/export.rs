@@ -128,6 +128,17 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
     let write = |bytes: Vec<u8>| -> anyhow::Result<()> {
         std::fs::write(&out, bytes).with_context(|| format!("writing {}", out.display()))
     };
+    if matches!(a.format, Format::Svg | Format::All) {
+        // The SVG's scale note: only when Origami Simulator would need a finer tolerance.
+        let sc = svg::svg_scale(p, &svg::SvgOptions::default())?;
+        if !sc.imports_with_default_tolerance() {
+            eprintln!(
+                "warning: {}: crease pattern SVG: {}",
+                a.design.display(),
+                sc.note
+            );
+        }
+    }
     match a.format {
         Format::Fold => write(export::fold::to_fold_string(p, meta, a.spec)?.into_bytes())?,
         Format::Svg => write(

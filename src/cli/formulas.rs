@@ -1,11 +1,17 @@
-//! `foldsynth formulas SPEC [--format …] [--simplify] [--gradient] [--symbolic-sectors]`:
-//! the symbolic U, θ, φ of a vertex, with node and operation counts.
+//! `foldsynth formulas SPEC [--format …] [--simplify] [--gradient] [--symbolic-sectors]
+//! [--backend egg|symbolica] [--output FILE]`: the symbolic U, θ, φ of a vertex, with node
+//! and operation counts; and the model formulas that `foldsynth model --formulas` prints
+//! ([`model_formulas`]).
 
 use crate::compile::simplify::{self, Limits};
 use crate::compile::{gradients, vertex::VertexModel};
 use crate::expr::{Counts, ExprGraph, Format, Names, NodeId, print::print};
 use crate::kinematics::VertexSpec;
-use anyhow::{Context, Result};
+use crate::model::Model;
+use crate::model::compiled::symbolic;
+use anyhow::{Context, Result, bail};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 /// Output formats of `foldsynth formulas`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -34,6 +40,16 @@ impl From<FormatArg> for Format {
     }
 }
 
+/// Who simplifies and prints the formulas.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Backend {
+    /// foldsynth's own: construction folding, egg, the DAG printers.
+    #[default]
+    Egg,
+    /// Symbolica's canonical form and printer (needs the `symbolica` cargo feature).
+    Symbolica,
+}
+
 /// Arguments of `foldsynth formulas`.
 #[derive(Debug, clap::Args)]
 pub struct FormulasArgs {
@@ -42,16 +58,25 @@ pub struct FormulasArgs {
     /// Output format.
     #[arg(long, value_enum, default_value = "plain")]
     pub format: FormatArg,
-    /// Print the formulas after egg simplification.
+    /// Print the formulas after egg simplification (with `--backend symbolica`: hand
+    /// Symbolica the egg-simplified graph instead of the graph as built).
     #[arg(long)]
     pub simplify: bool,
-    /// Also print the gradients of φ1, φ2, φ3 with respect to the variables.
+    /// Also print the gradients of φ1, φ2, φ3 with respect to the variables (with
+    /// `--backend symbolica`: Symbolica's derivatives).
     #[arg(long)]
     pub gradient: bool,
     /// Make the sector angles symbols alpha1…alphan (otherwise they are the spec's numbers
     /// and t is the only variable).
     #[arg(long)]
     pub symbolic_sectors: bool,
+    /// Who simplifies and prints: foldsynth (egg) or Symbolica (canonical form; plain,
+    /// latex or mathematica; operation counts before and after beside ours).
+    #[arg(long, value_enum, default_value = "egg")]
+    pub backend: Backend,
+    /// Write the formulas to this file instead of standard output.
+    #[arg(long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
 }
 
 /// What `foldsynth formulas` prints: the graph, its named outputs and the counts.
@@ -102,7 +127,8 @@ pub fn formulas(args: &FormulasArgs) -> Result<Formulas> {
     let mut names: Vec<String> = named.iter().map(|(n, _)| n.clone()).collect();
     let values = g.counts(&outs);
     let mut with_gradients: Option<Counts> = None;
-    if args.gradient {
+    // Symbolica differentiates on its own side.
+    if args.gradient && args.backend == Backend::Egg {
         let phis: Vec<NodeId> = outs[6..9].to_vec();
         let grads = gradients(&mut g, &phis, model.n_vars)?;
         for (k, grad) in grads.into_iter().enumerate() {
@@ -128,31 +154,63 @@ pub fn formulas(args: &FormulasArgs) -> Result<Formulas> {
     })
 }
 
+/// The comment delimiters of a format (start, end).
+fn comment_marks(format: Format) -> (&'static str, &'static str) {
+    match format {
+        Format::Plain | Format::Python => ("# ", ""),
+        Format::Latex => ("% ", ""),
+        Format::Mathematica => ("(* ", " *)"),
+        Format::Dot => ("// ", ""),
+    }
+}
+
+/// Header lines as comments of `format`, then `body`.
+pub fn with_header(format: Format, head: &[String], body: &str) -> String {
+    let (start, end) = comment_marks(format);
+    let mut s = String::new();
+    for h in head {
+        for line in h.lines() {
+            s.push_str(start);
+            s.push_str(line);
+            s.push_str(end);
+            s.push('\n');
+        }
+    }
+    s.push_str(body);
+    s
+}
+
+fn pct(a: usize, b: usize) -> f64 {
+    100.0 * (a as f64 - b as f64) / a.max(1) as f64
+}
+
 /// The formulas (and counts, as comments) as text in the requested format.
 pub fn render(args: &FormulasArgs) -> Result<String> {
+    if args.backend == Backend::Symbolica {
+        return render_symbolica(args);
+    }
     let f = formulas(args)?;
     let format: Format = args.format.into();
     let body = print(&f.graph, &f.outputs, &f.names, format);
-    let (spec, before, after, values, report) = (&f.spec, f.before, f.after, f.values, &f.report);
-    let model_names = &f.names;
-    let comment = match format {
-        Format::Plain | Format::Python => "# ",
-        Format::Latex => "% ",
-        Format::Mathematica => "(* ",
-        Format::Dot => "// ",
-    };
-    let end = if format == Format::Mathematica {
-        " *)"
-    } else {
-        ""
-    };
-    let pct = |a: usize, b: usize| 100.0 * (a as f64 - b as f64) / a.max(1) as f64;
-    let mut head = vec![
-        format!("vertex {spec}"),
+    let mut head = vertex_head(&f, args);
+    if let Some(c) = f.with_gradients {
+        head.push(format!(
+            "with the gradients of phi1..3: {} nodes, {} operations",
+            c.nodes, c.ops
+        ));
+    }
+    Ok(with_header(format, &head, &body))
+}
+
+/// The header lines shared by both backends: the vertex, the names, our counts.
+fn vertex_head(f: &Formulas, args: &FormulasArgs) -> Vec<String> {
+    let (before, after, values, report) = (f.before, f.after, f.values, &f.report);
+    vec![
+        format!("vertex {}", f.spec),
         format!(
             "variables: {}; parameters: {}",
-            model_names.vars.join(", "),
-            model_names.params.join(", ")
+            f.names.vars.join(", "),
+            f.names.params.join(", ")
         ),
         format!(
             "U, theta, phi as built: {} nodes, {} operations ({} calls)",
@@ -178,26 +236,240 @@ pub fn render(args: &FormulasArgs) -> Result<String> {
             values.nodes,
             values.ops
         ),
-    ];
-    if let Some(c) = f.with_gradients {
-        head.push(format!(
-            "with the gradients of phi1..3: {} nodes, {} operations",
-            c.nodes, c.ops
-        ));
+    ]
+}
+
+#[cfg(feature = "symbolica")]
+fn render_symbolica(args: &FormulasArgs) -> Result<String> {
+    use crate::compile::symbolica::{self as sym, PrintFormat};
+    let format = match args.format {
+        FormatArg::Plain => PrintFormat::Plain,
+        FormatArg::Latex => PrintFormat::Latex,
+        FormatArg::Mathematica => PrintFormat::Mathematica,
+        FormatArg::Python | FormatArg::Dot => bail!(
+            "--backend symbolica prints plain, latex or mathematica (python and dot come from --backend egg)"
+        ),
+    };
+    let f = formulas(args)?;
+    let job = sym::Job {
+        graph: f.graph.clone(),
+        outputs: f.outputs.clone(),
+        names: f.names.clone(),
+        n_vars: f.n_vars,
+        n_params: f.n_params,
+    };
+    let printed = sym::print(job, format, args.gradient)?;
+    let mut head = vertex_head(&f, args);
+    head.extend(printed.header());
+    Ok(with_header(args.format.into(), &head, &printed.text))
+}
+
+#[cfg(not(feature = "symbolica"))]
+fn render_symbolica(_: &FormulasArgs) -> Result<String> {
+    bail!("{}", NO_SYMBOLICA)
+}
+
+/// The error of every Symbolica option in a build without the feature.
+pub const NO_SYMBOLICA: &str = "this foldsynth was built without Symbolica; rebuild with `cargo build --release --features symbolica`";
+
+/// Write `text` to `path` (saying so on stderr), or to standard output.
+pub fn emit(text: &str, path: Option<&Path>) -> Result<()> {
+    match path {
+        None => print!("{text}"),
+        Some(p) => {
+            std::fs::write(p, text)
+                .with_context(|| format!("--output: cannot write {}", p.display()))?;
+            eprintln!("wrote {} ({} lines)", p.display(), text.lines().count());
+        }
     }
-    let mut s = String::new();
-    for h in head {
-        s.push_str(comment);
-        s.push_str(&h);
-        s.push_str(end);
-        s.push('\n');
-    }
-    s.push_str(&body);
-    Ok(s)
+    Ok(())
 }
 
 /// Run `foldsynth formulas`.
 pub fn run(args: FormulasArgs) -> Result<()> {
-    print!("{}", render(&args)?);
-    Ok(())
+    emit(&render(&args)?, args.output.as_deref())
+}
+
+/// What `foldsynth model --formulas` prints.
+#[derive(Clone, Copy, Debug)]
+pub struct ModelFormulaOptions {
+    /// Output format.
+    pub format: Format,
+    /// Print the egg-simplified graph (otherwise the graph as built).
+    pub simplify: bool,
+    /// Also print the gradient of the objective and of every constraint.
+    pub gradient: bool,
+}
+
+/// Variable names for printers that need identifiers (α_5 → alpha_5, l_2,5 → l_2_5).
+pub fn ascii_name(name: &str) -> String {
+    name.replace('α', "alpha").replace([',', '\''], "_")
+}
+
+/// A model's variable names (ASCII) and parameter names: the modes `M1…`, then the times
+/// `t0` (t_max) and the targets' `t1…`.
+pub fn model_names(model: &Model) -> Names {
+    Names {
+        vars: model
+            .free
+            .iter()
+            .map(|&i| ascii_name(&model.plan.variables[i].name))
+            .collect(),
+        params: (0..model.plan.internal.len())
+            .map(|k| format!("M{}", k + 1))
+            .chain((0..model.times.len()).map(|k| format!("t{k}")))
+            .collect(),
+    }
+}
+
+/// How many reachable nodes of each kind (`+`, `sin`, …) a graph has.
+fn kinds(graph: &ExprGraph, outputs: &[NodeId]) -> BTreeMap<&'static str, usize> {
+    let mark = graph.reachable(outputs);
+    let mut k = BTreeMap::new();
+    for (n, m) in graph.nodes().iter().zip(&mark) {
+        if *m && !n.is_leaf() {
+            *k.entry(n.kind_name()).or_insert(0) += 1;
+        }
+    }
+    k
+}
+
+/// "3 ×, 2 neg" style list of the operations one graph has more of than the other.
+fn kind_diff(more: &BTreeMap<&'static str, usize>, less: &BTreeMap<&'static str, usize>) -> String {
+    let parts: Vec<String> = more
+        .iter()
+        .filter_map(|(k, &n)| {
+            let m = less.get(k).copied().unwrap_or(0);
+            (n > m).then(|| format!("{} {k}", n - m))
+        })
+        .collect();
+    if parts.is_empty() {
+        "nothing".to_string()
+    } else {
+        parts.join(", ")
+    }
+}
+
+/// The objective and constraint formulas of `model` (task `task`), with a header that says
+/// what every simplification stage removed.
+pub fn model_formulas(model: &Model, task: &str, opts: ModelFormulaOptions) -> Result<String> {
+    let (ctx, outputs) = symbolic(model);
+    let ids: Vec<NodeId> = outputs.iter().map(|o| ctx.node_id(o)).collect();
+    let graph = ctx.to_graph();
+    let mut out_names = vec!["objective".to_string()];
+    out_names.extend((1..ids.len()).map(|k| format!("g{k}")));
+    let n_modes = model.plan.internal.len();
+    let names = model_names(model);
+
+    let before = graph.counts(&ids);
+    let (simplified, s_ids, rep) = simplify::simplify(&graph, &ids, &Limits::default());
+    let after = simplified.counts(&s_ids);
+    let (mut g, mut outs) = if opts.simplify {
+        (simplified.clone(), s_ids.clone())
+    } else {
+        graph.extract(&ids)
+    };
+    let values = g.counts(&outs);
+    let mut printed: Vec<(String, NodeId)> = out_names.iter().cloned().zip(outs.clone()).collect();
+    let mut gradient_line = None;
+    if opts.gradient {
+        let grads = gradients(&mut g, &outs, model.free.len())?;
+        let mut zeros = 0;
+        for (k, grad) in grads.into_iter().enumerate() {
+            for (i, d) in grad.into_iter().enumerate() {
+                if g.const_value(d) == Some(0.0) {
+                    zeros += 1;
+                    continue;
+                }
+                printed.push((format!("d{}_d{}", out_names[k], names.vars[i]), d));
+                outs.push(d);
+            }
+        }
+        let c = g.counts(&outs);
+        gradient_line = Some(format!(
+            "with the gradients (reverse mode on the printed graph): {} operations ({} calls); {zeros} partial derivatives that are identically 0 are left out",
+            c.ops, c.calls
+        ));
+    }
+
+    let labels: Vec<String> = (0..ids.len() - 1)
+        .map(|k| format!("  g{} = {}", k + 1, model.constraint_label(k)))
+        .collect();
+    let times: Vec<String> = model
+        .times
+        .iter()
+        .enumerate()
+        .map(|(k, t)| {
+            format!(
+                "t{k} = {t:?}{}",
+                if k == 0 { " (t_max)" } else { " (target)" }
+            )
+        })
+        .collect();
+    let mut fired: Vec<String> = rep
+        .rules_fired
+        .iter()
+        .filter(|(r, _)| !r.starts_with("comm-"))
+        .map(|(r, n)| format!("{r} {n}"))
+        .collect();
+    if fired.is_empty() {
+        fired.push("none".to_string());
+    }
+    let (kb, ka) = (kinds(&graph, &ids), kinds(&simplified, &s_ids));
+    let mut head = vec![
+        format!(
+            "model {} of task '{task}', gripping vertex v{} (candidate {}): objective and {} constraints g >= 0",
+            model.plan.sequence,
+            model.plan.vertices[model.gripping].name,
+            model.candidate + 1,
+            ids.len() - 1
+        ),
+        format!("variables: {}", names.vars.join(", ")),
+        format!(
+            "parameters: {} (rigid body modes, +1 up, -1 down); {}",
+            names.params[..n_modes].join(", "),
+            times.join(", ")
+        ),
+        "constraints:".to_string(),
+    ];
+    head.extend(labels);
+    head.extend([
+        format!(
+            "as built: {} operations ({} calls); construction already folds constants and exact identities (x*1, x+0, -(-x), (-x)-y = -(x+y), x*0 and x-x where x is proven finite)",
+            before.ops, before.calls
+        ),
+        format!(
+            "egg: {} operations ({} calls), {:.1}% fewer; {} e-nodes, {} iterations ({}), {:.1} ms",
+            after.ops,
+            after.calls,
+            pct(before.ops, after.ops),
+            rep.egraph_nodes,
+            rep.iterations,
+            rep.stop_reason,
+            rep.millis
+        ),
+        format!("  egg removed: {}", kind_diff(&kb, &ka)),
+        format!("  egg added: {}", kind_diff(&ka, &kb)),
+        format!(
+            "  rules that fired (e-graph applications, commutativity left out): {}",
+            fired.join(", ")
+        ),
+        format!(
+            "printed: the graph {} ({} operations){}",
+            if opts.simplify {
+                "after egg"
+            } else {
+                "as built (--no-simplify)"
+            },
+            values.ops,
+            if opts.simplify {
+                "; --no-simplify prints it as built"
+            } else {
+                ""
+            }
+        ),
+    ]);
+    head.extend(gradient_line);
+    let body = print(&g, &printed, &names, opts.format);
+    Ok(with_header(opts.format, &head, &body))
 }

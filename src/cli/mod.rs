@@ -5,10 +5,12 @@ use clap::{Parser, Subcommand};
 pub mod bench;
 pub mod bench_model;
 pub mod bench_numeric;
+pub mod bench_symbolica;
 pub mod compile;
 pub mod enumerate;
 pub mod export;
 pub mod formulas;
+pub mod fuzz;
 pub mod merge;
 pub mod model;
 pub mod optimize_flasher;
@@ -57,6 +59,8 @@ pub enum Command {
     Simulate(simulate::SimulateArgs),
     /// Optimize the adapted flasher by simulated annealing (thesis Sec. 3.6-3.7).
     OptimizeFlasher(optimize_flasher::OptimizeFlasherArgs),
+    /// Fuzz every parser: generated and mutated inputs, panics, aborts and hangs reported.
+    Fuzz(fuzz::FuzzArgs),
 }
 
 /// A check the command ran failed (`verify`, `simulate` compared with the PTU, a
@@ -109,5 +113,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Verify(a) => verify::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::OptimizeFlasher(a) => optimize_flasher::run(a),
+        Command::Fuzz(a) => fuzz::run(a),
     }
 }

@@ -1,14 +1,15 @@
 //! `foldsynth model TASK --graph SEQ [--modes …] [--candidate K] [--at VARS.json]
-//! [--formulas FORMAT] [--json]`: the optimization model of one graph, compiled, evaluated
-//! and verified.
+//! [--formulas FORMAT [--no-simplify] [--gradient] [--output FILE]] [--json]`: the
+//! optimization model of one graph, compiled, evaluated and verified.
 
 use crate::check::verify::{Tolerances, verify};
 use crate::compile::Options;
-use crate::expr::{Format, Names, print::print};
+use crate::expr::Format;
 use crate::grammar::{CreaseGraph, VarKind};
-use crate::model::compiled::{CompiledModel, ModelProblem, objective_target, symbolic};
+use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
 use crate::model::{Model, Plan};
+use crate::simulate::crossval::{CyclicVerdict, verify_cyclic};
 use crate::task::Task;
 use anyhow::{Context, Result, bail};
 use serde_json::json;
@@ -34,25 +35,41 @@ pub struct ModelArgs {
     #[arg(long, value_name = "VARS.json")]
     pub at: Option<PathBuf>,
     /// Print the objective and constraint formulas in this format
-    /// (plain, latex, mathematica, python, dot).
+    /// (plain, latex, mathematica, python, dot), simplified by egg, with a header that
+    /// says what each simplification removed.
     #[arg(long, value_name = "FORMAT")]
     pub formulas: Option<String>,
+    /// With --formulas: print the graph as built, before egg.
+    #[arg(long, requires = "formulas")]
+    pub no_simplify: bool,
+    /// With --formulas: also print the gradient of the objective and of every constraint
+    /// with respect to the free variables.
+    #[arg(long, requires = "formulas")]
+    pub gradient: bool,
+    /// With --formulas: write them to this file instead of standard output.
+    #[arg(long, value_name = "FILE", requires = "formulas")]
+    pub output: Option<PathBuf>,
     /// Optimize this alternative first (multi-start augmented Lagrangian), then evaluate
     /// and verify at the optimum.
     #[arg(long)]
     pub optimize: bool,
-    /// Starting points for --optimize.
-    #[arg(long, default_value_t = 32)]
+    /// Starting points for --optimize, 1 to 1000.
+    #[arg(long, default_value_t = 32, value_parser = crate::limits::count::<1, { crate::limits::STARTS_MAX as u64 }>)]
     pub starts: usize,
     /// Seed for --optimize.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Number of states of the verification sweep over [0, t_max] (as `synthesize --sweep`).
-    #[arg(long, default_value_t = crate::search::SearchOptions::default().sweep)]
+    /// Number of states of the verification sweep over [0, t_max] (as `synthesize --sweep`), 2 to 10000.
+    #[arg(long, default_value_t = crate::search::SearchOptions::default().sweep, value_parser = crate::limits::count::<2, { crate::limits::SWEEP_MAX as u64 }>)]
     pub sweep: usize,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
+    /// Write the design (variables, verification, pattern with 33 frames, metadata) to
+    /// this JSON file, as `synthesize` writes `designs/<id>.json`: `foldsynth export` and
+    /// `foldsynth simulate` read it.
+    #[arg(long, value_name = "DESIGN.json")]
+    pub save: Option<PathBuf>,
 }
 
 /// Parse "up,down,…" into ±1 for `n` internal vertices.
@@ -78,8 +95,8 @@ pub fn parse_modes(text: Option<&str>, n: usize) -> Result<Vec<f64>> {
 
 /// Read variable values for the model's free variables from a JSON file.
 pub fn read_vars(model: &Model, path: &Path) -> Result<Vec<f64>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::limits::read_text(path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("{}: not valid JSON", path.display()))?;
     let obj = v.get("variables").unwrap_or(&v);
@@ -149,6 +166,18 @@ pub fn run(args: ModelArgs) -> Result<()> {
     let model = Model::from_plan(plan, &task, args.candidate - 1)?;
     let n = model.plan.internal.len();
     let modes = parse_modes(args.modes.as_deref(), n)?;
+    if let Some(fmt) = &args.formulas {
+        let format: Format = fmt
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--formulas: {e}"))?;
+        let opts = super::formulas::ModelFormulaOptions {
+            format,
+            simplify: !args.no_simplify,
+            gradient: args.gradient,
+        };
+        let text = super::formulas::model_formulas(&model, &task.name, opts)?;
+        return super::formulas::emit(&text, args.output.as_deref());
+    }
     let mut x = match &args.at {
         Some(p) => read_vars(&model, p)?,
         None => middle(&model),
@@ -163,7 +192,16 @@ pub fn run(args: ModelArgs) -> Result<()> {
             ..Default::default()
         };
         let t0 = std::time::Instant::now();
-        let sol = crate::optimize::minimize(&problem, &opts);
+        let mut sol = crate::optimize::minimize(&problem, &opts);
+        // Cyclic patterns: Newton on the compatibility equations, to rounding.
+        crate::model::cycle::polish_solution(
+            &problem,
+            &model,
+            &modes,
+            &mut sol,
+            opts.feasibility_tol,
+            opts.target,
+        );
         eprintln!(
             "optimized in {:.1} ms: {} starts, {} evaluations, feasible {}, target met {}",
             t0.elapsed().as_secs_f64() * 1e3,
@@ -185,36 +223,34 @@ pub fn run(args: ModelArgs) -> Result<()> {
         &sample_times(model.t_max, args.sweep.max(2)),
         &Tolerances::default(),
     );
+    // A cyclic pattern (r2′): the compatibility sweep and the bar-and-hinge simulation.
+    let cycle = (!model.plan.sinks.is_empty()).then(|| {
+        verify_cyclic(
+            &model,
+            &full,
+            &modes,
+            args.sweep.max(2),
+            Tolerances::default().geometry_margin,
+        )
+    });
+    if let Some(path) = &args.save {
+        save_design(
+            path,
+            &task,
+            &model,
+            &x,
+            &modes,
+            omega,
+            &report,
+            cycle.as_ref(),
+        )?;
+    }
     let rep = &compiled.compiled.report;
     let layout = &compiled.compiled.layout;
     let constraint_values: Vec<f64> = (0..compiled.n_constraints)
         .map(|k| buf[layout.value(k + 1)])
         .collect();
     let gripping = model.plan.vertices[model.gripping].name;
-
-    if let Some(fmt) = &args.formulas {
-        let format: Format = fmt
-            .parse()
-            .map_err(|e| anyhow::anyhow!("--formulas: {e}"))?;
-        let (ctx, outputs) = symbolic(&model);
-        let mut named = vec![("objective".to_string(), ctx.node_id(&outputs[0]))];
-        for (k, o) in outputs[1..].iter().enumerate() {
-            named.push((format!("g{}", k + 1), ctx.node_id(o)));
-        }
-        let names = Names {
-            vars: model
-                .free
-                .iter()
-                .map(|&i| ascii_name(&model.plan.variables[i].name))
-                .collect(),
-            params: (0..n)
-                .map(|k| format!("M{}", k + 1))
-                .chain((0..model.times.len()).map(|k| format!("t{k}")))
-                .collect(),
-        };
-        println!("{}", print(&ctx.graph(), &named, &names, format));
-        return Ok(());
-    }
 
     if args.json {
         let variables: Vec<_> = model
@@ -249,6 +285,10 @@ pub fn run(args: ModelArgs) -> Result<()> {
             "compile_ms": compiled.total_ms,
             "verification": report,
         });
+        let mut out = out;
+        if let Some(c) = &cycle {
+            out["cycle"] = json!(c);
+        }
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
@@ -332,7 +372,122 @@ pub fn run(args: ModelArgs) -> Result<()> {
         "  rigid over the motion {}  (at t_max: {}; smallest margin {:.3e} at t = {:.6})",
         report.rigid_over_motion, report.rigid_at_tmax, report.min_margin, report.min_margin_t
     );
+    if let Some(c) = &cycle {
+        print_cycle(c, model.t_max);
+    }
+    if let Some(path) = &args.save {
+        println!("\ndesign written to {}", path.display());
+    }
     Ok(())
+}
+
+/// The verdict on a cyclic design, in words.
+fn print_cycle(c: &CyclicVerdict, t_max: f64) {
+    let s = &c.sweep;
+    println!(
+        "\ncyclic pattern ({} r2′ sink{}): compatibility over {} states in [0, {t_max:.6}] ({} rigid):",
+        s.sinks,
+        if s.sinks == 1 { "" } else { "s" },
+        s.states,
+        s.checked_states
+    );
+    println!(
+        "  dihedral angles from both ends, max difference  {:.3e}  (t = {:.6})",
+        s.compatibility_max, s.compatibility_t
+    );
+    println!(
+        "  positions through every facet, max disagreement {:.3e}  (t = {:.6})",
+        s.position_max, s.position_t
+    );
+    println!(
+        "  largest fold-angle change between states      {:.3e}  (after t = {:.6}; at most {} for one continuous motion)",
+        s.jump_max,
+        s.jump_t,
+        crate::check::cycle::JUMP_TOL
+    );
+    println!(
+        "  largest fold angle of the straight crease        {:.3e}{}",
+        s.shared_fold_max,
+        if s.folds_shared_crease() {
+            ""
+        } else {
+            "  (it never folds: the cycle closes trivially)"
+        }
+    );
+    match (&c.simulation, &c.error) {
+        (Some(r), _) => println!(
+            "  bar-and-hinge simulation ({} steps, driven by G0's crease): Γ = {:.3e}, max δ = {:.3e}, max |x − X_PTU| = {:.3e}: {}",
+            r.steps,
+            r.gamma,
+            r.max_delta,
+            r.max_position_error,
+            if r.agrees { "agrees" } else { "DISAGREES" }
+        ),
+        (None, Some(e)) => println!("  bar-and-hinge simulation failed: {e}"),
+        (None, None) => println!("  bar-and-hinge simulation not run: the sweep failed"),
+    }
+    println!(
+        "  verdict: {}",
+        if c.passes {
+            "folds rigidly (both verifications pass)"
+        } else {
+            "does not fold rigidly over the whole motion"
+        }
+    );
+}
+
+/// Write a design file (see [`ModelArgs::save`]).
+#[allow(clippy::too_many_arguments)]
+fn save_design(
+    path: &Path,
+    task: &Task,
+    model: &Model,
+    x: &[f64],
+    modes: &[f64],
+    omega: f64,
+    report: &crate::check::verify::VerifyReport,
+    cycle: Option<&CyclicVerdict>,
+) -> Result<()> {
+    let names: Vec<String> = modes
+        .iter()
+        .map(|m| if *m > 0.0 { "up" } else { "down" }.to_string())
+        .collect();
+    let full = model.full_vars(x);
+    let design = Evaluated::new(&model.plan, full.clone(), modes.to_vec());
+    let pattern = design.pattern(&sample_times(model.t_max, 33));
+    let mut meta = crate::search::model_meta(task, model, &names, omega);
+    meta.extra
+        .insert("candidate".into(), json!(model.candidate + 1));
+    let variables: std::collections::BTreeMap<&str, f64> = model
+        .free
+        .iter()
+        .zip(x)
+        .map(|(&i, v)| (model.plan.variables[i].name.as_str(), *v))
+        .collect();
+    let all: std::collections::BTreeMap<&str, f64> = model
+        .plan
+        .variables
+        .iter()
+        .zip(&full)
+        .map(|(v, x)| (v.name.as_str(), *x))
+        .collect();
+    let doc = json!({
+        "task": task.name,
+        "sequence": model.plan.sequence,
+        "candidate": model.candidate + 1,
+        "gripping_vertex": model.plan.vertices[model.gripping].name,
+        "modes": names,
+        "objective": omega,
+        "threshold": model.threshold,
+        "variables": variables,
+        "all_variables": all,
+        "verification": report,
+        "cycle": cycle,
+        "pattern": pattern,
+        "meta": meta,
+    });
+    std::fs::write(path, serde_json::to_string_pretty(&doc)?)
+        .with_context(|| format!("cannot write {}", path.display()))
 }
 
 fn kind(k: VarKind) -> &'static str {
@@ -340,9 +495,4 @@ fn kind(k: VarKind) -> &'static str {
         VarKind::Sector => "sector",
         VarKind::Length => "length",
     }
-}
-
-/// Variable names for printers that need identifiers (α_5 → alpha_5, l_2,5 → l_2_5).
-fn ascii_name(name: &str) -> String {
-    name.replace('α', "alpha").replace([',', '\''], "_")
 }

@@ -15,7 +15,7 @@ use crate::simulate::flasher::{
 #[derive(Debug, Args)]
 pub struct OptimizeFlasherArgs {
     /// Objective evaluations (the thesis: 50 × 50 = 2500).
-    #[arg(long, default_value_t = 2500, value_parser = clap::value_parser!(u64).range(1..=10_000_000))]
+    #[arg(long, default_value_t = 2500, value_parser = clap::value_parser!(u64).range(1..=crate::limits::EVALS_MAX))]
     pub evals: u64,
     /// Seed of the random start point and moves.
     #[arg(long, default_value_t = 1)]

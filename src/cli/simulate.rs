@@ -42,7 +42,7 @@ pub struct SimulateArgs {
     pub crossval: Option<PathBuf>,
     /// Number of folding steps J (default: the file's `motion.steps`; for FOLD/design files
     /// one step per frame after the first, or 30 without frames).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=crate::limits::STEPS_MAX))]
     pub steps: Option<u64>,
     /// FOLD/design: the driven crease (0-based edge index; default: the edge marked
     /// driven).
@@ -191,7 +191,7 @@ fn legend(names: &[String]) -> String {
 /// A design JSON: `{"pattern": <Pattern>, …}` (any other keys are ignored), or a bare
 /// Pattern. Returns a display name (`id`, else the file name) and the pattern.
 pub fn read_design(path: &Path) -> anyhow::Result<(String, Pattern)> {
-    let text = std::fs::read_to_string(path)
+    let text = crate::limits::read_text(path)
         .with_context(|| format!("{}: cannot read", path.display()))?;
     let v: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("{}: not valid JSON", path.display()))?;
@@ -295,6 +295,18 @@ fn run_pattern(
     let r = crossval::crossval(pattern, &drive, &opts)
         .with_context(|| format!("simulating {}", path.display()))?;
     let seconds = start.elapsed().as_secs_f64();
+    // Comparing with the file's frames is a check: disagreement exits with status 1.
+    let verdict = || -> anyhow::Result<()> {
+        if r.compared_states > 0 && !r.agrees(GAMMA_TOL, POSITION_TOL) {
+            return Err(super::CheckFailed(format!(
+                "{name}: the simulation does not agree with the file's frames (max |x - X| {}, Γ {})",
+                crate::text::num(r.max_position_error),
+                crate::text::num(r.gamma)
+            ))
+            .into());
+        }
+        Ok(())
+    };
     if args.json {
         let mut out = serde_json::to_value(&r)?;
         let extra = json!({
@@ -313,7 +325,8 @@ fn run_pattern(
         if let (Some(o), Some(e)) = (out.as_object_mut(), extra.as_object()) {
             o.extend(e.clone());
         }
-        return emit(&(serde_json::to_string_pretty(&out)? + "\n"));
+        emit(&(serde_json::to_string_pretty(&out)? + "\n"))?;
+        return verdict();
     }
     let mut o = String::new();
     let [p, q] = pattern.edges[drive.edge].v;
@@ -360,7 +373,8 @@ fn run_pattern(
     let names: Vec<String> = (0..pattern.vertices.len()).map(|i| i.to_string()).collect();
     positions(&mut o, &names, r.sim.final_positions());
     let _ = writeln!(o, "time                {seconds:.3} s");
-    emit(&o)
+    emit(&o)?;
+    verdict()
 }
 
 /// One design of a `--crossval` run.

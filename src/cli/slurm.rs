@@ -47,6 +47,12 @@ pub struct SlurmArgs {
     /// The merged run skips exports and the report.
     #[arg(long)]
     pub no_export: bool,
+    /// The grammar's rules: r1,r2 (the thesis's, default) or r1,r2,r2p (with r2′).
+    #[arg(long, default_value = "r1,r2", value_name = "RULES")]
+    pub rules: crate::grammar::Rules,
+    /// Optimize without the robustness block and only check afterwards (as in the thesis).
+    #[arg(long)]
+    pub post_check_only: bool,
 }
 
 /// Run `foldsynth slurm`.
@@ -73,6 +79,8 @@ pub fn run(args: SlurmArgs) -> Result<()> {
             seed: args.seed,
             sweep: args.sweep,
             export: !args.no_export,
+            rules: args.rules,
+            post_check_only: args.post_check_only,
             foldsynth,
         },
     )?;

@@ -18,7 +18,7 @@ pub struct SynthesizeArgs {
     /// run of the same settings (see --force).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Worker threads; 0 means one per core (at most 256).
+    /// Worker threads, 0 (one per core) to 256.
     #[arg(long, default_value_t = 0, value_parser = limits::count::<0, { limits::JOBS_MAX as u64 }>)]
     pub jobs: usize,
     /// Starting points per design alternative, 1 to 1000.
@@ -38,8 +38,8 @@ pub struct SynthesizeArgs {
     /// Override the task's maximum number of internal vertices, 1 to 6.
     #[arg(long, value_parser = limits::count::<1, { limits::N_MAX as u64 }>)]
     pub n_max: Option<usize>,
-    /// States of the rigidity/verification sweep over [0, t_max], 2 to 10000 (181: every 0.5°
-    /// of a π/2 motion; `model --sweep` has the same default).
+    /// States of the rigidity/verification sweep over [0, t_max], 2 to 10000 (181: every
+    /// 0.5° of a π/2 motion; `model --sweep` has the same default).
     #[arg(long, default_value_t = SearchOptions::default().sweep, value_parser = limits::count::<2, { limits::SWEEP_MAX as u64 }>)]
     pub sweep: usize,
     /// Skip the per-design FOLD/SVG/OBJ/STL/picture/animation files (the design JSONs and
@@ -54,6 +54,14 @@ pub struct SynthesizeArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
+    /// The grammar's rules: r1,r2 (the thesis's, default) or r1,r2,r2p (with r2′: cyclic,
+    /// overconstrained patterns such as the Miura-ori, verified by simulation).
+    #[arg(long, default_value = "r1,r2", value_name = "RULES")]
+    pub rules: crate::grammar::Rules,
+    /// Today's behaviour before issue 12: optimize without the clearance and margin
+    /// constraints, judge only afterwards (to compare the two on the same alternatives).
+    #[arg(long)]
+    pub post_check_only: bool,
 }
 
 /// Run `foldsynth synthesize`.
@@ -76,6 +84,8 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         sweep: args.sweep,
         export: !args.no_export,
         progress: true,
+        rules: args.rules,
+        post_check_only: args.post_check_only,
     };
     if let Some(spec) = args.shard {
         // The text the task was read from, kept with the shard for the merge.

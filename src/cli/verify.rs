@@ -9,37 +9,48 @@ use crate::export::verify::{VerifyOptions, verify_file};
 pub struct VerifyArgs {
     /// The FOLD file.
     pub file: PathBuf,
-    /// Isometry tolerance, relative to each face's size.
+    /// Isometry and flatness tolerance, relative to each face's (the sheet's) size; the
+    /// file's own precision is added to it.
     #[arg(long, default_value_t = 1e-9, allow_hyphen_values = true)]
     pub tol: f64,
-    /// Fold-angle and sector-sum tolerance in degrees.
+    /// Fold-angle and sector-sum tolerance in degrees; the file's own precision is added.
     #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
     pub angle_tol: f64,
+    /// Significant digits of the file's coordinates, 1 to 17 (default: detected; 17 takes
+    /// them as exact).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=17))]
+    pub digits: Option<u32>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
 }
 
-/// Run `foldsynth verify`; fails (non-zero exit) when any check fails.
+/// Run `foldsynth verify`; exit status 1 when a check fails, 2 when the file cannot be
+/// read as FOLD.
 pub fn run(a: VerifyArgs) -> anyhow::Result<()> {
     for (name, v) in [("--tol", a.tol), ("--angle-tol", a.angle_tol)] {
-        if !(v.is_finite() && v > 0.0) {
-            anyhow::bail!("{name} {v}: must be a positive number");
+        if !(v.is_finite() && v > 0.0 && v <= 1.0e3) {
+            anyhow::bail!(
+                "{name} {}: must be a positive number (at most 1000)",
+                crate::text::num(v)
+            );
         }
     }
     let opts = VerifyOptions {
         tol: a.tol,
         angle_tol_deg: a.angle_tol,
+        digits: a.digits,
     };
     let report = verify_file(&a.file, &opts)?;
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+    let text = if a.json {
+        serde_json::to_string_pretty(&report)? + "\n"
     } else {
-        print!("{report}");
-    }
+        report.to_string()
+    };
+    super::simulate::emit(&text)?;
     if report.ok {
         Ok(())
     } else {
-        anyhow::bail!("{}: verification failed", a.file.display())
+        Err(super::CheckFailed(format!("{}: verification failed", a.file.display())).into())
     }
 }

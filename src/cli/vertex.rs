@@ -23,10 +23,21 @@ pub struct VertexArgs {
 /// The sampled values of `t`.
 fn parse_range(text: &str) -> Result<Vec<f64>> {
     let constant = |part: &str, what: &str| -> Result<f64> {
-        let e = DriveExpr::parse(part).with_context(|| format!("--t: bad {what} '{part}'"))?;
+        let e = DriveExpr::parse(part)
+            .with_context(|| format!("--t: bad {what} '{}'", crate::text::excerpt(part, 40)))?;
         let v = e.eval(&f64::NAN);
+        if v.is_finite() && v.abs() > crate::limits::COORD_MAX {
+            bail!(
+                "--t: the {what} {} is out of range: ±{} radians at most",
+                crate::text::num(v),
+                crate::text::num(crate::limits::COORD_MAX)
+            );
+        }
         if !v.is_finite() {
-            bail!("--t: the {what} '{part}' must be a number (it may use pi, not t)");
+            bail!(
+                "--t: the {what} '{}' must be a number (it may use pi, not t)",
+                crate::text::excerpt(part, 40)
+            );
         }
         Ok(v)
     };
@@ -36,19 +47,36 @@ fn parse_range(text: &str) -> Result<Vec<f64>> {
         [a, b, n] => {
             let (a, b) = (constant(a, "range start")?, constant(b, "range end")?);
             let n: usize = n.trim().parse().map_err(|_| {
-                anyhow::anyhow!("--t: the sample count '{n}' must be a whole number ≥ 2")
+                anyhow::anyhow!(
+                    "--t: the sample count '{}' must be a whole number from 2 to {}",
+                    crate::text::excerpt(n, 40),
+                    crate::limits::SAMPLES_MAX
+                )
             })?;
             if n < 2 {
                 bail!("--t: a range needs at least 2 samples, got {n}");
             }
+            if n > crate::limits::SAMPLES_MAX {
+                bail!(
+                    "--t: {n} samples is over the limit of {} (each sample is a row of output)",
+                    crate::limits::SAMPLES_MAX
+                );
+            }
             if a >= b {
-                bail!("--t: the range {a}:{b} is empty; the start must be smaller than the end");
+                bail!(
+                    "--t: the range {}:{} is empty; the start must be smaller than the end",
+                    crate::text::num(a),
+                    crate::text::num(b)
+                );
             }
             Ok((0..n)
                 .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
                 .collect())
         }
-        _ => bail!("--t: expected a value T or a range A:B:N, got '{text}'"),
+        _ => bail!(
+            "--t: expected a value T or a range A:B:N, got '{}'",
+            crate::text::excerpt(text, 40)
+        ),
     }
 }
 

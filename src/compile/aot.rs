@@ -5,13 +5,15 @@
 //!
 //! The object exports `void NAME_eval(const double *vars, const double *params, double
 //! *out)` and small functions that report the sizes, names, bounds, default parameters
-//! and constants of an [`Interface`]; all of it is generated code and data, so the only
-//! run-time dependency is the C library's libm (`sin`, `cos`, `acos`, `atan2`, `sincos`).
+//! and constants of an [`Interface`]; all of it is generated code and data (the
+//! transcendentals inline, [`Math::Inline`]: the same bits as the JIT), so the only
+//! run-time dependency is the C library's `sin` and `cos`, called for arguments beyond
+//! 10⁶ only.
 //! The code is for the host's architecture with baseline features (any CPU of that
 //! architecture runs it) and position independent.
 
 use super::Layout;
-use super::codegen::{self, CompileError, OptLevel, Target, cg};
+use super::codegen::{self, CompileError, Math, OptLevel, Target, cg};
 use crate::expr::{ExprGraph, NodeId, check_indices};
 use cranelift_codegen::Context;
 use cranelift_codegen::ir::{AbiParam, InstBuilder, UserFuncName};
@@ -228,8 +230,7 @@ pub fn object(
         ObjectBuilder::new(isa, iface.name.as_bytes(), default_libcall_names()).map_err(cg)?;
     let mut module = ObjectModule::new(builder);
     let name = &iface.name;
-    // glibc and musl have sincos; macOS's libm does not.
-    let fuse_sincos = cfg!(target_os = "linux");
+    // Self-contained: the transcendentals as inline code (the same bits as the JIT's).
     codegen::define_eval(
         &mut module,
         &format!("{name}_eval"),
@@ -237,7 +238,7 @@ pub fn object(
         graph,
         outputs,
         &mark,
-        fuse_sincos,
+        Math::Inline,
     )?;
     for k in iface.all_constants(layout) {
         define_size_fn(&mut module, &format!("{name}_{}", k.name), k.value)?;

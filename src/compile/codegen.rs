@@ -4,18 +4,27 @@
 //! [`cranelift_module::Module`], so the in-process evaluator and the shared library are
 //! the same Cranelift IR and cannot drift.
 //!
-//! Transcendentals are calls to the C library's `sin`, `cos`, `acos`, `atan2` and
-//! `sincos` (the JIT binds those names to Rust's `f64` methods, the very functions the
-//! interpreter calls; a shared library gets them from libm). `sqrt` is the native
-//! instruction; `sgn`, `clamp`, `select` and the clamp in front of `acos` are `fcmp` +
-//! `select`, with exactly the NaN behaviour of [`Node::eval_with`].
+//! `sin`, `cos`, `atan2` and `acos` are [`crate::trig`]'s kernels, the very functions the
+//! interpreter and the `f64` kinematics use, so every backend computes the same bits:
+//! - [`Math::Batch`] (the JIT): the transcendentals are grouped by how many transcendentals
+//!   lie below them; each group is one call of [`crate::trig::trig_batch`] (four lanes of
+//!   AVX2 at a time) through a stack buffer, and uses reload the results from there. A
+//!   call costs more than the call (every value live across it is in a caller-saved
+//!   register, spilled and reloaded), so one call per group instead of one per function
+//!   pays twice;
+//! - [`Math::Inline`] (the self-contained library): the kernels as straight-line IR in the
+//!   function, with the C library's `sin`/`cos` on a cold path for `|x| > 10⁶`.
+//!
+//! `sqrt` is the native instruction; `sgn`, `clamp`, `select` and the clamp in front of
+//! `acos` are `fcmp` + `select`, with exactly the NaN behaviour of [`Node::eval_with`].
 
 use crate::expr::{ExprGraph, FxHashMap, Node, NodeId, ShapeError};
+use crate::trig::{self, Ops};
 use cranelift_codegen::Context;
 use cranelift_codegen::ir::condcodes::FloatCC;
 use cranelift_codegen::ir::{
-    AbiParam, FuncRef, InstBuilder, MemFlagsData, Signature, StackSlotData, StackSlotKind,
-    UserFuncName, Value, types,
+    AbiParam, BlockArg, FuncRef, InstBuilder, MemFlagsData, Signature, StackSlotData,
+    StackSlotKind, UserFuncName, Value, types,
 };
 use cranelift_codegen::isa::OwnedTargetIsa;
 use cranelift_codegen::settings::{self, Configurable};
@@ -62,13 +71,27 @@ pub enum OptLevel {
     None,
 }
 
+/// How the generated code computes `sin`, `cos`, `atan2` and `acos` (the same bits either
+/// way: [`crate::trig`]'s kernels).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Math {
+    /// Grouped calls of [`crate::trig::trig_batch`] (in-process code only).
+    #[default]
+    Batch,
+    /// The kernels inlined as IR (what a library without foldsynth needs); the C
+    /// library's `sin` and `cos` on a cold path for arguments beyond
+    /// [`crate::trig::SIN_COS_MAX_ARG`].
+    Inline,
+}
+
 /// The size up to which [`OptLevel::Auto`] optimizes for speed.
 pub const AUTO_SPEED_MAX_NODES: usize = 2000;
 
-/// The C library's names of the functions the generated code calls, in the order of
-/// [`Math`]'s fields: `double sin(double)`, `cos`, `acos`, `double atan2(double, double)`,
-/// `void sincos(double, double *, double *)`.
-pub const MATH_SYMBOLS: [&str; 5] = ["sin", "cos", "acos", "atan2", "sincos"];
+/// The C library's functions that [`Math::Inline`] code may call (on its cold path).
+pub const MATH_SYMBOLS: [&str; 2] = ["sin", "cos"];
+
+/// The symbol the JIT binds to [`crate::trig::trig_batch`].
+pub(crate) const TRIG_BATCH_SYMBOL: &str = "foldsynth_trig_batch";
 
 /// Where the code runs: decides the ISA flags, not the IR.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -123,19 +146,69 @@ pub(crate) fn isa(
 pub(crate) struct Built {
     /// The function.
     pub id: FuncId,
-    /// IR instructions emitted for the nodes (before Cranelift's optimizations).
+    /// IR instructions emitted for the nodes (kernels and batches included).
     pub n_instructions: usize,
-    /// Calls to the math functions.
+    /// Calls emitted (batches, or the cold-path calls of inline code).
     pub n_calls: usize,
 }
 
-/// Lazily imported math functions of one function body.
-struct Math {
-    sin: Option<FuncRef>,
-    cos: Option<FuncRef>,
-    acos: Option<FuncRef>,
-    atan2: Option<FuncRef>,
-    sincos: Option<FuncRef>,
+/// The Cranelift backend of [`trig`]'s kernels.
+struct Ir<'a, 'f> {
+    b: &'a mut FunctionBuilder<'f>,
+}
+
+impl Ops for Ir<'_, '_> {
+    type V = Value;
+    fn c(&mut self, x: f64) -> Value {
+        self.b.ins().f64const(x)
+    }
+    fn add(&mut self, a: Value, b: Value) -> Value {
+        self.b.ins().fadd(a, b)
+    }
+    fn sub(&mut self, a: Value, b: Value) -> Value {
+        self.b.ins().fsub(a, b)
+    }
+    fn mul(&mut self, a: Value, b: Value) -> Value {
+        self.b.ins().fmul(a, b)
+    }
+    fn div(&mut self, a: Value, b: Value) -> Value {
+        self.b.ins().fdiv(a, b)
+    }
+    fn sqrt(&mut self, a: Value) -> Value {
+        self.b.ins().sqrt(a)
+    }
+    fn abs(&mut self, a: Value) -> Value {
+        self.b.ins().fabs(a)
+    }
+    fn copysign(&mut self, a: Value, b: Value) -> Value {
+        self.b.ins().fcopysign(a, b)
+    }
+    fn lt_select(&mut self, a: Value, b: Value, x: Value, y: Value) -> Value {
+        let c = self.b.ins().fcmp(FloatCC::LessThan, a, b);
+        self.b.ins().select(c, x, y)
+    }
+    fn eq_select(&mut self, a: Value, b: Value, x: Value, y: Value) -> Value {
+        let c = self.b.ins().fcmp(FloatCC::Equal, a, b);
+        self.b.ins().select(c, x, y)
+    }
+    fn sign_select(&mut self, m: Value, x: Value, y: Value) -> Value {
+        let flags = MemFlagsData::new();
+        let bits = self.b.ins().bitcast(types::I64, flags, m);
+        let mask = self.b.ins().sshr_imm_u(bits, 63);
+        let mask = self.b.ins().bitcast(types::F64, flags, mask);
+        self.b.ins().bitselect(mask, x, y)
+    }
+    fn bit_to_sign(&mut self, v: Value, bit: u32) -> Value {
+        let flags = MemFlagsData::new();
+        let bits = self.b.ins().bitcast(types::I64, flags, v);
+        let bits = self.b.ins().ishl_imm_u(bits, i64::from(63 - bit));
+        self.b.ins().bitcast(types::F64, flags, bits)
+    }
+    fn flip_sign(&mut self, a: Value, m: Value) -> Value {
+        let sign = self.b.ins().f64const(-0.0);
+        let s = self.b.ins().band(m, sign);
+        self.b.ins().bxor(a, s)
+    }
 }
 
 /// `x` clamped to `[-1, 1]` as `f64::clamp`: NaN fails both comparisons and stays NaN.
@@ -148,10 +221,43 @@ fn clamp_unit(b: &mut FunctionBuilder, x: Value) -> Value {
     b.ins().select(gt, one, lo)
 }
 
+fn is_trig(n: &Node) -> bool {
+    matches!(
+        n,
+        Node::Sin(_) | Node::Cos(_) | Node::Atan2(..) | Node::Acos(_)
+    )
+}
+
+/// One group of transcendentals handed to [`trig::trig_batch`] in one call.
+#[derive(Default)]
+struct Batch {
+    /// Arguments of sin/cos (each once), atan2 nodes, acos nodes.
+    sc: Vec<NodeId>,
+    at: Vec<usize>,
+    ac: Vec<usize>,
+    /// Where the group's buffer starts in the function's batch slot (in f64s).
+    base: u32,
+}
+
+impl Batch {
+    fn len(&self) -> usize {
+        3 * self.sc.len() + 3 * self.at.len() + 2 * self.ac.len()
+    }
+}
+
+/// Where a node's value comes from.
+#[derive(Clone, Copy)]
+enum Source {
+    /// Not emitted yet.
+    None,
+    /// An SSA value.
+    Value(Value),
+    /// The batch slot at this f64 offset (reloaded at each use).
+    Slot(u32),
+}
+
 /// Define `name` in `module`: the function computing `outputs` of `graph` (`mark`: the
-/// nodes they reach, from [`crate::expr::check_indices`]). With `fuse_sincos`, `sin x` and
-/// `cos x` of one `x` are one `sincos` call (glibc and musl have it; macOS's libm does
-/// not).
+/// nodes they reach, from [`crate::expr::check_indices`]) with transcendentals by `mode`.
 pub(crate) fn define_eval<M: Module>(
     module: &mut M,
     name: &str,
@@ -159,7 +265,7 @@ pub(crate) fn define_eval<M: Module>(
     graph: &ExprGraph,
     outputs: &[NodeId],
     mark: &[bool],
-    fuse_sincos: bool,
+    mode: Math,
 ) -> Result<Built, CompileError> {
     let ptr = module.target_config().pointer_type();
     let mut sig = module.make_signature();
@@ -167,40 +273,49 @@ pub(crate) fn define_eval<M: Module>(
         sig.params.push(AbiParam::new(ptr));
     }
     let func_id = module.declare_function(name, linkage, &sig).map_err(cg)?;
+    let nodes = graph.nodes();
 
-    let mut sig1 = module.make_signature();
-    sig1.params.push(AbiParam::new(types::F64));
-    sig1.returns.push(AbiParam::new(types::F64));
-    let mut sig2: Signature = sig1.clone();
-    sig2.params.push(AbiParam::new(types::F64));
-    let mut sig_sc = sig1.clone();
-    sig_sc.returns.clear();
-    sig_sc.params.push(AbiParam::new(ptr));
-    sig_sc.params.push(AbiParam::new(ptr));
-    let sigs = [&sig1, &sig1, &sig1, &sig2, &sig_sc];
-    let mut ids = Vec::with_capacity(MATH_SYMBOLS.len());
-    for (name, sig) in MATH_SYMBOLS.iter().zip(sigs) {
-        ids.push(
-            module
-                .declare_function(name, Linkage::Import, sig)
-                .map_err(cg)?,
-        );
-    }
-    // sin x and cos x of one x, both needed: one sincos call.
-    let fused: Vec<bool> = graph
-        .nodes()
-        .iter()
-        .enumerate()
-        .map(|(i, n)| {
-            fuse_sincos
-                && mark[i]
-                && match *n {
-                    Node::Sin(a) => graph.lookup(&Node::Cos(a)).is_some_and(|c| mark[c.index()]),
-                    Node::Cos(a) => graph.lookup(&Node::Sin(a)).is_some_and(|c| mark[c.index()]),
-                    _ => false,
+    // Math::Batch: group the transcendentals by depth (how many transcendentals lie on
+    // the deepest path below them): a group's arguments only need smaller depths.
+    let mut depth = vec![0u32; nodes.len()];
+    let mut batches: Vec<Batch> = Vec::new();
+    if mode == Math::Batch {
+        for (i, n) in nodes.iter().enumerate() {
+            if mark[i] {
+                depth[i] = n
+                    .children()
+                    .into_iter()
+                    .map(|c| depth[c.index()] + u32::from(is_trig(&nodes[c.index()])))
+                    .max()
+                    .unwrap_or(0);
+            }
+        }
+        let mut seen: FxHashMap<(u32, NodeId), ()> = FxHashMap::default();
+        for (i, n) in nodes.iter().enumerate() {
+            if !mark[i] || !is_trig(n) {
+                continue;
+            }
+            let d = depth[i] as usize;
+            if batches.len() <= d {
+                batches.resize_with(d + 1, Batch::default);
+            }
+            match *n {
+                Node::Sin(a) | Node::Cos(a) => {
+                    if seen.insert((d as u32, a), ()).is_none() {
+                        batches[d].sc.push(a);
+                    }
                 }
-        })
-        .collect();
+                Node::Atan2(..) => batches[d].at.push(i),
+                _ => batches[d].ac.push(i),
+            }
+        }
+        let mut base = 0u32;
+        for bt in &mut batches {
+            bt.base = base;
+            base += bt.len() as u32;
+        }
+    }
+    let slot_len: u32 = batches.iter().map(|b| b.len() as u32).sum();
 
     let mut ctx: Context = module.make_context();
     ctx.func.signature = sig;
@@ -217,115 +332,165 @@ pub(crate) fn define_eval<M: Module>(
         let p = b.block_params(block).to_vec();
         let (vars_p, params_p, out_p) = (p[0], p[1], p[2]);
         let mem = MemFlagsData::trusted();
-        let mut math = Math {
-            sin: None,
-            cos: None,
-            acos: None,
-            atan2: None,
-            sincos: None,
-        };
-        let slot =
-            b.create_sized_stack_slot(StackSlotData::new(StackSlotKind::ExplicitSlot, 16, 3));
-        let mut slot_addr: Option<Value> = None;
-        // Results of fused sincos calls, by argument node.
+        let slot = (slot_len > 0).then(|| {
+            b.create_sized_stack_slot(StackSlotData::new(
+                StackSlotKind::ExplicitSlot,
+                8 * slot_len,
+                3,
+            ))
+        });
+        // Imported lazily: the batch function, or libm's sin and cos for the cold path.
+        let mut batch_fn: Option<FuncRef> = None;
+        let mut libm_fns: Option<(FuncRef, FuncRef)> = None;
+        let mut src: Vec<Source> = vec![Source::None; nodes.len()];
+        // Inline sin/cos by argument node.
         let mut sincos_done: FxHashMap<NodeId, (Value, Value)> = FxHashMap::default();
-        let mut import = |slot: &mut Option<FuncRef>, id: FuncId, b: &mut FunctionBuilder| {
-            *slot.get_or_insert_with(|| module.declare_func_in_func(id, b.func))
-        };
-        let mut val: Vec<Option<Value>> = vec![None; graph.len()];
         // Operand values. Constants are materialized at each use rather than once: a
         // constant shared by thousands of nodes would otherwise be one value live across
-        // the whole function (and across every libm call).
-        let operand = |b: &mut FunctionBuilder, val: &[Option<Value>], id: NodeId| -> Value {
-            match *graph.node(id) {
-                Node::Const(c) => b.ins().f64const(c),
-                _ => val[id.index()].expect("children are emitted first"),
+        // the whole function (and across every call); batch results likewise are reloaded
+        // from their slot.
+        let operand = |b: &mut FunctionBuilder, src: &[Source], id: NodeId| -> Value {
+            match (*graph.node(id), src[id.index()]) {
+                (Node::Const(c), _) => b.ins().f64const(c),
+                (_, Source::Value(v)) => v,
+                (_, Source::Slot(off)) => b.ins().stack_load(
+                    ptr,
+                    types::F64,
+                    slot.expect("a slot exists"),
+                    8 * off as i32,
+                ),
+                (_, Source::None) => unreachable!("children are emitted first"),
             }
         };
-        // Node order (children first): the forward pass with its libm calls comes first,
-        // the arithmetic of the gradients after it. (A depth-first schedule that emits
-        // each node just before its first use compiled 2× slower on design models.)
-        for (i, node) in graph.nodes().iter().enumerate() {
-            if !mark[i] || matches!(node, Node::Const(_)) {
+
+        // Emission order: node order (children first), so the forward pass precedes the
+        // arithmetic of the gradients (a depth-first schedule that emits each node just
+        // before its first use compiled 2× slower on design models). With batches: by
+        // depth, each depth's plain nodes, then its batch.
+        let order: Vec<Vec<usize>> = if mode == Math::Batch {
+            // A plain node is at most one deeper than the deepest batch.
+            let mut by_depth = vec![Vec::new(); batches.len() + 1];
+            for (i, n) in nodes.iter().enumerate() {
+                if mark[i] && !is_trig(n) && !matches!(n, Node::Const(_)) {
+                    by_depth[depth[i] as usize].push(i);
+                }
+            }
+            by_depth
+        } else {
+            vec![
+                (0..nodes.len())
+                    .filter(|&i| mark[i] && !matches!(nodes[i], Node::Const(_)))
+                    .collect(),
+            ]
+        };
+        for (d, phase) in order.iter().enumerate() {
+            for &i in phase {
+                let node = nodes[i];
+                let mut o = [None; 3];
+                for (k, c) in node.children().into_iter().enumerate() {
+                    // Inline sin/cos whose argument was already done needs no operand.
+                    if matches!(node, Node::Sin(_) | Node::Cos(_)) && sincos_done.contains_key(&c) {
+                        continue;
+                    }
+                    o[k] = Some(operand(&mut b, &src, c));
+                }
+                let v = |k: usize| o[k].expect("operand emitted");
+                let x = match node {
+                    Node::Const(_) => unreachable!("constants are emitted at their uses"),
+                    Node::Var(k) => b.ins().load(types::F64, mem, vars_p, 8 * k as i32),
+                    Node::Param(k) => b.ins().load(types::F64, mem, params_p, 8 * k as i32),
+                    Node::Add(..) => b.ins().fadd(v(0), v(1)),
+                    Node::Sub(..) => b.ins().fsub(v(0), v(1)),
+                    Node::Mul(..) => b.ins().fmul(v(0), v(1)),
+                    Node::Div(..) => b.ins().fdiv(v(0), v(1)),
+                    Node::Neg(_) => b.ins().fneg(v(0)),
+                    Node::Sqrt(_) => b.ins().sqrt(v(0)),
+                    Node::Sin(a) | Node::Cos(a) => {
+                        let (sv, cv) = match sincos_done.get(&a) {
+                            Some(&r) => r,
+                            None => {
+                                let fns = *libm_fns.get_or_insert_with(|| {
+                                    let [s, c] = import_libm(module, b.func);
+                                    (s, c)
+                                });
+                                let r = inline_sin_cos(&mut b, v(0), fns);
+                                n_calls += 2;
+                                sincos_done.insert(a, r);
+                                r
+                            }
+                        };
+                        if matches!(node, Node::Sin(_)) { sv } else { cv }
+                    }
+                    Node::Acos(_) => trig::emit_acos(&mut Ir { b: &mut b }, v(0)),
+                    Node::Atan2(..) => trig::emit_atan2(&mut Ir { b: &mut b }, v(0), v(1)),
+                    Node::Sgn(_) => {
+                        let a = v(0);
+                        let zero = b.ins().f64const(0.0);
+                        let one = b.ins().f64const(1.0);
+                        let mone = b.ins().f64const(-1.0);
+                        let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
+                        let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
+                        let neg_or_zero = b.ins().select(lt, mone, zero);
+                        b.ins().select(gt, one, neg_or_zero)
+                    }
+                    Node::Clamp(_) => clamp_unit(&mut b, v(0)),
+                    Node::Select(..) => {
+                        let zero = b.ins().f64const(0.0);
+                        let gt = b.ins().fcmp(FloatCC::GreaterThan, v(0), zero);
+                        b.ins().select(gt, v(1), v(2))
+                    }
+                };
+                n_inst += 1;
+                src[i] = Source::Value(x);
+            }
+            let Some(bt) = batches.get(d) else { continue };
+            if bt.len() == 0 {
                 continue;
             }
-            let mut o = [None; 3];
-            for (k, c) in node.children().into_iter().enumerate() {
-                // A fused sin/cos whose partner already called sincos needs no operand.
-                if fused[i] && sincos_done.contains_key(&c) {
+            // The batch: store the arguments, one call, results stay in the slot.
+            let slot = slot.expect("a slot exists");
+            let (nsc, nat, nac) = (bt.sc.len(), bt.at.len(), bt.ac.len());
+            let at = |k: usize| 8 * (bt.base as usize + k) as i32;
+            let mut stores: Vec<(NodeId, usize)> = Vec::new();
+            for (k, &a) in bt.sc.iter().enumerate() {
+                stores.push((a, k));
+            }
+            for (k, &i) in bt.at.iter().enumerate() {
+                let [y, x] = [0, 1].map(|j| nodes[i].children().as_slice()[j]);
+                stores.push((y, nsc + k));
+                stores.push((x, nsc + nat + k));
+            }
+            for (k, &i) in bt.ac.iter().enumerate() {
+                stores.push((nodes[i].children().as_slice()[0], nsc + 2 * nat + k));
+            }
+            for (id, k) in stores {
+                let x = operand(&mut b, &src, id);
+                b.ins().stack_store(ptr, x, slot, at(k));
+            }
+            let f = *batch_fn.get_or_insert_with(|| import_batch(module, b.func, ptr));
+            let addr = b.ins().stack_addr(ptr, slot, at(0));
+            let n = [nsc, nat, nac].map(|n| b.ins().iconst(ptr, n as i64));
+            b.ins().call(f, &[addr, n[0], n[1], n[2]]);
+            n_calls += 1;
+            n_inst += 1;
+            let out0 = bt.base + (nsc + 2 * nat + nac) as u32;
+            let by_arg: FxHashMap<NodeId, usize> =
+                bt.sc.iter().enumerate().map(|(k, &a)| (a, k)).collect();
+            for (i, n) in nodes.iter().enumerate() {
+                if !mark[i] || !is_trig(n) || depth[i] as usize != d {
                     continue;
                 }
-                o[k] = Some(operand(&mut b, &val, c));
+                let k = match *n {
+                    Node::Sin(a) => by_arg[&a],
+                    Node::Cos(a) => nsc + by_arg[&a],
+                    Node::Atan2(..) => 2 * nsc + bt.at.iter().position(|&j| j == i).unwrap_or(0),
+                    _ => 2 * nsc + nat + bt.ac.iter().position(|&j| j == i).unwrap_or(0),
+                };
+                src[i] = Source::Slot(out0 + k as u32);
             }
-            let v = |k: usize| o[k].expect("operand emitted");
-            let x = match *node {
-                Node::Const(_) => unreachable!("constants are emitted at their uses"),
-                Node::Var(k) => b.ins().load(types::F64, mem, vars_p, 8 * k as i32),
-                Node::Param(k) => b.ins().load(types::F64, mem, params_p, 8 * k as i32),
-                Node::Add(..) => b.ins().fadd(v(0), v(1)),
-                Node::Sub(..) => b.ins().fsub(v(0), v(1)),
-                Node::Mul(..) => b.ins().fmul(v(0), v(1)),
-                Node::Div(..) => b.ins().fdiv(v(0), v(1)),
-                Node::Neg(_) => b.ins().fneg(v(0)),
-                Node::Sqrt(_) => b.ins().sqrt(v(0)),
-                Node::Sin(a) | Node::Cos(a) if fused[i] => {
-                    let (sv, cv) = match sincos_done.get(&a) {
-                        Some(&r) => r,
-                        None => {
-                            let f = import(&mut math.sincos, ids[4], &mut b);
-                            let addr =
-                                *slot_addr.get_or_insert_with(|| b.ins().stack_addr(ptr, slot, 0));
-                            let c_ptr = b.ins().iadd_imm_s(addr, 8);
-                            b.ins().call(f, &[v(0), addr, c_ptr]);
-                            n_calls += 1;
-                            let sv = b.ins().load(types::F64, mem, addr, 0);
-                            let cv = b.ins().load(types::F64, mem, addr, 8);
-                            sincos_done.insert(a, (sv, cv));
-                            (sv, cv)
-                        }
-                    };
-                    if matches!(node, Node::Sin(_)) { sv } else { cv }
-                }
-                Node::Sin(_) | Node::Cos(_) | Node::Acos(_) => {
-                    let (slot, id, arg) = match node {
-                        Node::Sin(_) => (&mut math.sin, ids[0], v(0)),
-                        Node::Cos(_) => (&mut math.cos, ids[1], v(0)),
-                        // acos of the clamped argument: `acos_clamped`.
-                        _ => (&mut math.acos, ids[2], clamp_unit(&mut b, v(0))),
-                    };
-                    let f = import(slot, id, &mut b);
-                    let call = b.ins().call(f, &[arg]);
-                    n_calls += 1;
-                    b.inst_results(call)[0]
-                }
-                Node::Atan2(..) => {
-                    let f = import(&mut math.atan2, ids[3], &mut b);
-                    let call = b.ins().call(f, &[v(0), v(1)]);
-                    n_calls += 1;
-                    b.inst_results(call)[0]
-                }
-                Node::Sgn(_) => {
-                    let a = v(0);
-                    let zero = b.ins().f64const(0.0);
-                    let one = b.ins().f64const(1.0);
-                    let mone = b.ins().f64const(-1.0);
-                    let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
-                    let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
-                    let neg_or_zero = b.ins().select(lt, mone, zero);
-                    b.ins().select(gt, one, neg_or_zero)
-                }
-                Node::Clamp(_) => clamp_unit(&mut b, v(0)),
-                Node::Select(..) => {
-                    let zero = b.ins().f64const(0.0);
-                    let gt = b.ins().fcmp(FloatCC::GreaterThan, v(0), zero);
-                    b.ins().select(gt, v(1), v(2))
-                }
-            };
-            n_inst += 1;
-            val[i] = Some(x);
         }
         for (k, o) in outputs.iter().enumerate() {
-            let x = operand(&mut b, &val, *o);
+            let x = operand(&mut b, &src, *o);
             b.ins().store(mem, x, out_p, 8 * k as i32);
         }
         b.ins().return_(&[]);
@@ -339,4 +504,64 @@ pub(crate) fn define_eval<M: Module>(
         n_instructions: n_inst,
         n_calls,
     })
+}
+
+/// Import `void foldsynth_trig_batch(double *, size_t, size_t, size_t)`.
+fn import_batch<M: Module>(
+    module: &mut M,
+    func: &mut cranelift_codegen::ir::Function,
+    ptr: types::Type,
+) -> FuncRef {
+    let mut sig = module.make_signature();
+    for _ in 0..4 {
+        sig.params.push(AbiParam::new(ptr));
+    }
+    let id = module
+        .declare_function(TRIG_BATCH_SYMBOL, Linkage::Import, &sig)
+        .expect("the batch function's one signature");
+    module.declare_func_in_func(id, func)
+}
+
+/// Import libm's `double sin(double)` and `double cos(double)`.
+fn import_libm<M: Module>(
+    module: &mut M,
+    func: &mut cranelift_codegen::ir::Function,
+) -> [FuncRef; 2] {
+    let mut sig: Signature = module.make_signature();
+    sig.params.push(AbiParam::new(types::F64));
+    sig.returns.push(AbiParam::new(types::F64));
+    MATH_SYMBOLS.map(|name| {
+        let id = module
+            .declare_function(name, Linkage::Import, &sig)
+            .expect("libm's one signature");
+        module.declare_func_in_func(id, func)
+    })
+}
+
+/// `(sin x, cos x)` inline: the kernel, or the C library on a cold path beyond
+/// [`trig::SIN_COS_MAX_ARG`] (as [`trig::sin_cos`]).
+fn inline_sin_cos(b: &mut FunctionBuilder, x: Value, libm: (FuncRef, FuncRef)) -> (Value, Value) {
+    let hot = b.create_block();
+    let cold = b.create_block();
+    let join = b.create_block();
+    let s = b.append_block_param(join, types::F64);
+    let c = b.append_block_param(join, types::F64);
+    let ax = b.ins().fabs(x);
+    let lim = b.ins().f64const(trig::SIN_COS_MAX_ARG);
+    let far = b.ins().fcmp(FloatCC::GreaterThan, ax, lim);
+    b.ins().brif(far, cold, &[], hot, &[]);
+    b.switch_to_block(hot);
+    let (hs, hc) = trig::emit_sin_cos(&mut Ir { b }, x);
+    b.ins()
+        .jump(join, &[BlockArg::Value(hs), BlockArg::Value(hc)]);
+    b.switch_to_block(cold);
+    b.set_cold_block(cold);
+    let cs = b.ins().call(libm.0, &[x]);
+    let cs = b.inst_results(cs)[0];
+    let cc = b.ins().call(libm.1, &[x]);
+    let cc = b.inst_results(cc)[0];
+    b.ins()
+        .jump(join, &[BlockArg::Value(cs), BlockArg::Value(cc)]);
+    b.switch_to_block(join);
+    (s, c)
 }

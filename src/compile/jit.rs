@@ -2,12 +2,14 @@
 //! `extern "C" fn(vars: *const f64, params: *const f64, out: *mut f64)` in this process.
 //!
 //! The function body comes from [`super::codegen`], the builder the ahead-of-time object
-//! ([`super::aot`]) uses too. Here the math symbols it calls are bound to Rust's `f64`
-//! methods (the interpreter's very functions, so results agree bit for bit) and, on
-//! glibc, `sincos`.
+//! ([`super::aot`]) uses too. Its transcendentals are [`crate::trig`]'s kernels, the
+//! interpreter's very functions, so results agree bit for bit: the batch symbol is bound to
+//! [`crate::trig::trig_batch`], and `sin`/`cos` (the inline code's cold path) to Rust's
+//! `f64` methods, which [`crate::trig`] uses there too.
 
-use super::codegen::{self, CompileError, OptLevel, Target, cg};
+use super::codegen::{self, CompileError, Math, OptLevel, Target, cg};
 use crate::expr::{ExprGraph, NodeId, ShapeError, check_indices};
+use crate::trig;
 use cranelift_jit::{JITBuilder, JITModule};
 use cranelift_module::{Linkage, default_libcall_names};
 use std::mem::ManuallyDrop;
@@ -17,29 +19,6 @@ extern "C" fn fs_sin(x: f64) -> f64 {
 }
 extern "C" fn fs_cos(x: f64) -> f64 {
     x.cos()
-}
-extern "C" fn fs_acos(x: f64) -> f64 {
-    // The generated code clamps the argument first (`acos_clamped`).
-    x.acos()
-}
-extern "C" fn fs_atan2(y: f64, x: f64) -> f64 {
-    y.atan2(x)
-}
-
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-unsafe extern "C" {
-    /// glibc's `sincos`: one range reduction for both; bit-identical to `sin` and `cos`
-    /// (glibc computes all three with the same kernels; a test checks it).
-    fn sincos(x: f64, s: *mut f64, c: *mut f64);
-}
-
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-extern "C" fn sincos(x: f64, s: *mut f64, c: *mut f64) {
-    // SAFETY: the generated code passes two distinct, writable stack slots.
-    unsafe {
-        *s = x.sin();
-        *c = x.cos();
-    }
 }
 
 type RawFn = unsafe extern "C" fn(*const f64, *const f64, *mut f64);
@@ -60,7 +39,8 @@ pub struct CompiledFn {
 
 // SAFETY: after `finalize_definitions` the module is never mutated again; the only thing
 // used is the code pointer, and the generated code is reentrant (it reads its arguments,
-// writes its output slice and calls thread-safe libm functions). Dropping from another
+// writes its output slice and calls pure functions: the batch kernels work in the
+// caller's stack buffer). Dropping from another
 // thread only unmaps memory this value owns.
 unsafe impl Send for CompiledFn {}
 unsafe impl Sync for CompiledFn {}
@@ -95,27 +75,34 @@ impl CompiledFn {
         n_vars: usize,
         n_params: usize,
     ) -> Result<CompiledFn, CompileError> {
-        Self::with_opt_level(graph, outputs, n_vars, n_params, OptLevel::Auto)
+        Self::with_options(
+            graph,
+            outputs,
+            n_vars,
+            n_params,
+            OptLevel::Auto,
+            Math::Batch,
+        )
     }
 
-    /// [`CompiledFn::new`] with a chosen optimization level.
-    pub fn with_opt_level(
+    /// [`CompiledFn::new`] with a chosen optimization level and way of calling the
+    /// transcendentals.
+    pub fn with_options(
         graph: &ExprGraph,
         outputs: &[NodeId],
         n_vars: usize,
         n_params: usize,
         opt: OptLevel,
+        math: Math,
     ) -> Result<CompiledFn, CompileError> {
         let mark = check_indices(graph, outputs, n_vars, n_params)?;
         let n_nodes = mark.iter().filter(|m| **m).count();
         let isa = codegen::isa(Target::Jit, opt, n_nodes)?;
         let mut jb = JITBuilder::with_isa(isa, default_libcall_names());
-        let [sin, cos, acos, atan2, sc] = codegen::MATH_SYMBOLS;
+        let [sin, cos] = codegen::MATH_SYMBOLS;
         jb.symbol(sin, fs_sin as *const u8);
         jb.symbol(cos, fs_cos as *const u8);
-        jb.symbol(acos, fs_acos as *const u8);
-        jb.symbol(atan2, fs_atan2 as *const u8);
-        jb.symbol(sc, sincos as *const u8);
+        jb.symbol(codegen::TRIG_BATCH_SYMBOL, trig::trig_batch as *const u8);
         let mut module = JITModule::new(jb);
         let result = codegen::define_eval(
             &mut module,
@@ -124,7 +111,7 @@ impl CompiledFn {
             graph,
             outputs,
             &mark,
-            true,
+            math,
         );
         match result {
             Ok(built) => {
@@ -171,8 +158,8 @@ impl CompiledFn {
     pub fn n_instructions(&self) -> usize {
         self.n_instructions
     }
-    /// Number of calls to libm in the generated code (a `sin` and a `cos` of one
-    /// argument are one `sincos` call).
+    /// Number of calls in the generated code: one per batch of transcendentals (or, inline,
+    /// the cold-path calls).
     pub fn n_calls(&self) -> usize {
         self.n_calls
     }
@@ -247,6 +234,49 @@ mod tests {
     }
 
     #[test]
+    fn batched_inline_and_interpreted_transcendentals_are_the_same_bits() {
+        let ctx = Ctx::new();
+        let (x, y) = (ctx.var(0), ctx.var(1));
+        // Several depths of transcendentals, shared arguments, sin and cos of one argument.
+        let a = x.sin() * y.cos() + x.cos();
+        let b = a.atan2(&y) + (a.clone() * 0.3).acos();
+        let c = (b.clone() * x.clone()).sin() - (b.clone() + y.clone()).cos() * a.sin();
+        let outs = [a, b, c];
+        let ids: Vec<_> = outs.iter().map(|s| ctx.node_id(s)).collect();
+        let g = ctx.to_graph();
+        let batch = CompiledFn::new(&g, &ids, 2, 0).unwrap();
+        let inline =
+            CompiledFn::with_options(&g, &ids, 2, 0, OptLevel::Auto, Math::Inline).unwrap();
+        let tape = Tape::new(&g, &ids, 2, 0).unwrap();
+        assert!(
+            batch.n_calls() >= 3,
+            "one call per depth: {}",
+            batch.n_calls()
+        );
+        for &(p, q) in &[
+            (0.3, -1.2),
+            (2.0e6, 0.5),
+            (-7.5, 3.0e9),
+            (0.0, -0.0),
+            (f64::NAN, 1.0),
+        ] {
+            let mut r = [[0.0; 3]; 3];
+            batch.call(&[p, q], &[], &mut r[0]).unwrap();
+            inline.call(&[p, q], &[], &mut r[1]).unwrap();
+            tape.eval(&[p, q], &[], &mut r[2]).unwrap();
+            let want = r[2];
+            for (j, got) in r[..2].iter().enumerate() {
+                for (k, (&a, &b)) in got.iter().zip(&want).enumerate() {
+                    assert!(
+                        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
+                        "({p}, {q}) output {k}, backend {j}: {a} vs {b}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn shared_across_threads() {
         let ctx = Ctx::new();
         let x = ctx.var(0);
@@ -259,7 +289,7 @@ mod tests {
                 std::thread::spawn(move || {
                     let mut o = [0.0];
                     jit.call(&[k as f64], &[], &mut o).unwrap();
-                    o[0] == (k as f64).sin() * (k as f64).cos()
+                    o[0] == trig::sin(k as f64) * trig::cos(k as f64)
                 })
             })
             .collect();

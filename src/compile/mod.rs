@@ -22,26 +22,33 @@
 //! assert!((buf[c.layout.gradient(0).start] - d).abs() < 1e-15);
 //! ```
 //!
-//! Stages: [`simplify`] (egg), [`diff`] (reverse mode), [`codegen`] (the Cranelift function
+//! Stages: [`simplify`] (egg), [`diff`] (reverse mode) and [`jacobian`] (reverse sweeps or
+//! vertex elimination), [`codegen`] (the Cranelift function
 //! builder) behind [`jit`] (in process) and [`aot`] (object, shared library, C header); [`dual`] is
 //! the forward-mode oracle the tests hold the differentiator to; [`vertex`] builds the
 //! symbolic PTU of one vertex (for `foldsynth formulas` and `foldsynth bench vertex`).
+//! With the cargo feature `symbolica`, `symbolica` is the second pipeline and printer
+//! built on Symbolica (on its own thread).
 
 pub mod aot;
 pub mod codegen;
 pub mod diff;
 pub mod dual;
+pub mod jacobian;
 pub mod jit;
 pub mod simplify;
+#[cfg(feature = "symbolica")]
+pub mod symbolica;
 pub mod vertex;
 
-pub use codegen::{CompileError, OptLevel};
+pub use codegen::{CompileError, Math, OptLevel};
 pub use diff::{gradient, gradients};
 pub use dual::Dual;
+pub use jacobian::{Jacobian, jacobian};
 pub use jit::CompiledFn;
 
+use crate::cpu_time::Stopwatch;
 use crate::expr::{Counts, ExprGraph, NodeId, check_indices};
-use std::time::Instant;
 
 /// What [`compile`] does.
 #[derive(Clone, Debug)]
@@ -50,8 +57,13 @@ pub struct Options {
     pub simplify: Option<simplify::Limits>,
     /// Append the gradient of every output with respect to all variables.
     pub gradients: bool,
+    /// How those gradients are computed.
+    pub jacobian: Jacobian,
     /// Cranelift's optimization level.
     pub opt_level: OptLevel,
+    /// How the generated code computes `sin`, `cos`, `atan2` and `acos` (the same bits
+    /// either way).
+    pub math: Math,
 }
 
 impl Default for Options {
@@ -59,7 +71,9 @@ impl Default for Options {
         Options {
             simplify: Some(simplify::Limits::default()),
             gradients: true,
+            jacobian: Jacobian::default(),
             opt_level: OptLevel::Auto,
+            math: Math::default(),
         }
     }
 }
@@ -111,7 +125,7 @@ pub struct CompileReport {
     pub with_gradients: Counts,
     /// The simplifier's own report.
     pub simplify: Option<simplify::Report>,
-    /// Milliseconds in simplification.
+    /// Milliseconds in simplification (CPU time of the compiling thread, as the others).
     pub simplify_ms: f64,
     /// Milliseconds in differentiation.
     pub diff_ms: f64,
@@ -145,7 +159,7 @@ pub fn compile(
 ) -> Result<Compiled, CompileError> {
     check_indices(graph, outputs, n_vars, n_params)?;
     let input = graph.counts(outputs);
-    let t0 = Instant::now();
+    let t0 = Stopwatch::start();
     let (mut g, outs, srep) = match &opts.simplify {
         Some(limits) => {
             let (g, o, r) = simplify::simplify(graph, outputs, limits);
@@ -156,20 +170,20 @@ pub fn compile(
             (g, o, None)
         }
     };
-    let simplify_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let simplify_ms = t0.cpu_ms();
     let simplified = g.counts(&outs);
-    let t1 = Instant::now();
+    let t1 = Stopwatch::start();
     let mut all = outs.clone();
     if opts.gradients {
-        for grad in gradients(&mut g, &outs, n_vars)? {
+        for grad in jacobian(&mut g, &outs, n_vars, opts.jacobian)? {
             all.extend(grad);
         }
     }
-    let diff_ms = t1.elapsed().as_secs_f64() * 1e3;
+    let diff_ms = t1.cpu_ms();
     let with_gradients = g.counts(&all);
-    let t2 = Instant::now();
-    let function = CompiledFn::with_opt_level(&g, &all, n_vars, n_params, opts.opt_level)?;
-    let jit_ms = t2.elapsed().as_secs_f64() * 1e3;
+    let t2 = Stopwatch::start();
+    let function = CompiledFn::with_options(&g, &all, n_vars, n_params, opts.opt_level, opts.math)?;
+    let jit_ms = t2.cpu_ms();
     Ok(Compiled {
         function,
         layout: Layout {

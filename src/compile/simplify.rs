@@ -14,6 +14,11 @@
 //!   root of a negative number, and `1 - c` is exact near `c = 1` (no cancellation);
 //! - `x - x → 0`, `x * 0 → 0`, `sin²x + cos²x → 1` only where the range analysis proves
 //!   `x` finite; `x / x → 1` only where it also proves `x ≠ 0`;
+//! - cancellation across a sum, `a + (b - a) → b`, `(a + b) - a → b`, `a - (a - b) → b`,
+//!   again only where `a` is proven finite (`inf + (b - inf)` is NaN); the result is the
+//!   exact value of the rounded original (never less accurate);
+//! - `(-a) - b → -(a + b)` is exact (rounding is symmetric), so `-(-a - b)` becomes
+//!   `a + b`;
 //! - `(x + x·sgn x)/2 → select(x, x, 0)` (that is `max(0, x)`, how the kinematics
 //!   writes it): exact for finite `x` (`2x/2 = x`, `x - x = 0`), so again only where `x`
 //!   is proven finite;
@@ -326,12 +331,16 @@ pub fn rules() -> Vec<Rewrite<Math, Facts>> {
         rw!("mul-neg"; "(* ?a (neg ?b))" => "(neg (* ?a ?b))"),
         rw!("div-neg-l"; "(/ (neg ?a) ?b)" => "(neg (/ ?a ?b))"),
         rw!("div-neg-r"; "(/ ?a (neg ?b))" => "(neg (/ ?a ?b))"),
+        rw!("sub-neg-l"; "(- (neg ?a) ?b)" => "(neg (+ ?a ?b))"),
         // Units and cancellation.
         rw!("add-0"; "(+ ?a 0.0)" => "?a"),
         rw!("mul-1"; "(* ?a 1.0)" => "?a"),
         rw!("mul-0"; "(* ?a 0.0)" => "0.0" if is_finite("?a")),
         rw!("sub-self"; "(- ?a ?a)" => "0.0" if is_finite("?a")),
         rw!("div-self"; "(/ ?a ?a)" => "1.0" if is_nonzero("?a")),
+        rw!("add-sub-cancel"; "(+ ?a (- ?b ?a))" => "?b" if is_finite("?a")),
+        rw!("sub-add-cancel"; "(- (+ ?a ?b) ?a)" => "?b" if is_finite("?a")),
+        rw!("sub-sub-cancel"; "(- ?a (- ?a ?b))" => "?b" if is_finite("?a")),
         // Commutativity (needed to find common factors); no general associativity,
         // which blows the e-graph up without shrinking the PTU's expressions.
         rw!("comm-add"; "(+ ?a ?b)" => "(+ ?b ?a)"),
@@ -430,6 +439,10 @@ pub struct Report {
     /// Which extraction produced the result ("dag", "tree" or "input" when the input
     /// was kept).
     pub extraction: &'static str,
+    /// How often each rule was newly applied in the e-graph, summed over the iterations
+    /// (rules that never fired are left out; commutativity is counted like the others).
+    /// Applications are unions in the e-graph, not what the extraction kept.
+    pub rules_fired: Vec<(String, usize)>,
     /// Wall-clock time of the whole call.
     pub millis: f64,
 }
@@ -489,6 +502,16 @@ pub fn simplify(
         cost_after = dag_cost(&g, &outs);
     }
     let after = g.counts(&outs);
+    let mut fired: Vec<(String, usize)> = Vec::new();
+    for it in &runner.iterations {
+        for (rule, n) in &it.applied {
+            match fired.iter_mut().find(|(r, _)| r == rule.as_str()) {
+                Some((_, m)) => *m += n,
+                None => fired.push((rule.to_string(), *n)),
+            }
+        }
+    }
+    fired.retain(|(_, n)| *n > 0);
     let report = Report {
         ops_before: before.ops,
         ops_after: after.ops,
@@ -499,8 +522,12 @@ pub fn simplify(
         egraph_nodes: eg.total_number_of_nodes(),
         egraph_classes: eg.number_of_classes(),
         iterations: runner.iterations.len(),
-        stop_reason: format!("{:?}", runner.stop_reason),
+        stop_reason: runner
+            .stop_reason
+            .as_ref()
+            .map_or_else(|| "none".to_string(), |r| format!("{r:?}")),
         extraction,
+        rules_fired: fired,
         millis: t0.elapsed().as_secs_f64() * 1e3,
     };
     (g, outs, report)

@@ -18,13 +18,15 @@ use std::time::Instant;
 
 use super::DistributeError;
 use super::shard::assign;
-use crate::search::output::{RECORDS, RunSettings, SETTINGS, ShardSpec, digest};
+use crate::grammar::Rules;
+use crate::search::output::{RECORDS, RunSettings, SETTINGS, ShardSpec};
 use crate::search::plan::Done;
 use crate::search::{
     self, AlternativeRecord, Evaluation, FailedModel, Plan, SHARD_REPORT, SHARD_TASK,
     SearchOptions, ShardReport, Summary,
 };
 use crate::task::Task;
+use crate::task::digest;
 
 /// How many missing alternatives an error names per shard.
 const MISSING_SHOWN: usize = 5;
@@ -329,6 +331,12 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
         shard: None,
         ..shards[0].settings.clone()
     };
+    let rules = match &settings.rules {
+        None => Rules::default(),
+        Some(names) => Rules::parse(names).map_err(|m| {
+            DistributeError::input(shards[0].dir.join(SETTINGS), format!("rules: {m}"))
+        })?,
+    };
     let search_opts = SearchOptions {
         out: opts.out.clone(),
         jobs: opts.jobs,
@@ -340,9 +348,11 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
         sweep: settings.sweep,
         export: opts.export,
         progress: false,
+        rules,
+        post_check_only: settings.post_check_only,
     };
     let n_max = search::check_search(&task, &search_opts)?;
-    let plan = search::plan(&task, n_max)?;
+    let plan = search::plan(&task, n_max, rules)?;
     let deal = assign(&plan, shards[0].spec.count);
 
     // Every shard complete, every record in its place, before anything is written.

@@ -11,9 +11,10 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 use super::DistributeError;
-use crate::search::output::{ShardSpec, digest};
+use crate::search::output::ShardSpec;
 use crate::search::{self, Plan, SearchOptions, ShardReport, Share};
 use crate::task::Task;
+use crate::task::digest;
 
 /// The units of each of `count` shards (shard k at index k − 1), each in record order.
 pub fn assign(plan: &Plan, count: usize) -> Vec<Vec<usize>> {
@@ -57,7 +58,7 @@ pub fn run(
         ));
     }
     let n_max = search::check_search(task, opts)?;
-    let plan = search::plan(task, n_max)?;
+    let plan = search::plan(task, n_max, opts.rules)?;
     let units = share(&plan, spec);
     Ok(search::run_shard(
         task,

@@ -38,6 +38,11 @@ pub struct SlurmOptions {
     pub sweep: usize,
     /// Exports and report in the merged run.
     pub export: bool,
+    /// The grammar's rules (every shard's search uses them; merge reads them from the
+    /// shards' settings).
+    pub rules: crate::grammar::Rules,
+    /// Optimize without the robustness block (`--post-check-only`).
+    pub post_check_only: bool,
     /// The foldsynth binary the jobs run.
     pub foldsynth: PathBuf,
 }
@@ -174,6 +179,12 @@ pub fn write_scripts(
         " --starts {} --seed {} --sweep {}",
         opts.starts, opts.seed, opts.sweep
     );
+    if opts.rules != crate::grammar::Rules::default() {
+        settings += &format!(" --rules {}", opts.rules.names());
+    }
+    if opts.post_check_only {
+        settings += " --post-check-only";
+    }
     let header = |job: &str, log: &str| {
         let mut h = format!(
             "#!/bin/bash\n#SBATCH --job-name={job}\n#SBATCH --cpus-per-task={}\n",

@@ -5,7 +5,8 @@
 //! The key frame (top level) is the crease pattern: `frame_classes: ["creasePattern"]`,
 //! 2D `vertices_coords`, `edges_vertices`, `edges_assignment`, `edges_foldAngle` (degrees,
 //! valley positive, of the *final* folded state, so tools that fold a crease pattern to
-//! its target, like Origami Simulator, reach our final state), and counter-clockwise
+//! its target, like Origami Simulator, reach our final state; `null` for boundary edges,
+//! which have no fold angle), and counter-clockwise
 //! `faces_vertices`. Every folded state is one entry of `file_frames` with
 //! `frame_classes: ["foldedForm"]`, `frame_parent: 0`, `frame_inherit: true`, its own 3D
 //! `vertices_coords` and `edges_foldAngle`, and `foldsynth:t`.
@@ -162,14 +163,21 @@ pub fn to_fold_string(p: &Pattern, meta: &DesignMeta, spec: FoldSpec) -> super::
     validate_pattern(p)?;
     validate_meta(meta, p)?;
     let assign = assignments(p);
-    let final_angles: Vec<f64> = match p.frames.last() {
-        Some(f) => f
-            .fold_angles
+    // Boundary edges have no fold angle: `null`, as Origami Simulator writes them (it
+    // draws a line with opacity |angle|/180, so 0 would hide the boundary).
+    let angles_deg = |f: Option<&Frame>| -> Vec<Option<f64>> {
+        p.edges
             .iter()
-            .map(|&a| wrap(a).to_degrees())
-            .collect(),
-        None => vec![0.0; p.edges.len()],
+            .enumerate()
+            .map(|(i, e)| match e.kind {
+                EdgeKind::Boundary => None,
+                EdgeKind::Crease { .. } => {
+                    Some(f.map_or(0.0, |f| wrap(f.fold_angles[i]).to_degrees()))
+                }
+            })
+            .collect()
     };
+    let final_angles = angles_deg(p.frames.last());
     let mut top: Vec<(String, String)> = Vec::new();
     let put = |k: &str, v: Value, indent: usize| (k.to_string(), render_value(&v, indent));
     let title = if meta.rule_sequence.is_empty() {
@@ -228,11 +236,7 @@ pub fn to_fold_string(p: &Pattern, meta: &DesignMeta, spec: FoldSpec) -> super::
             .frames
             .iter()
             .map(|f| {
-                let angles: Vec<f64> = f
-                    .fold_angles
-                    .iter()
-                    .map(|&a| wrap(a).to_degrees())
-                    .collect();
+                let angles = angles_deg(Some(f));
                 let entries = vec![
                     (
                         "frame_title".to_string(),
@@ -298,6 +302,9 @@ pub struct FoldFile {
     pub edges_derived: bool,
     /// Whether the faces were derived from the planar graph.
     pub faces_derived: bool,
+    /// Whether `edges_assignment` was absent: then edges of exactly one face are `B`,
+    /// the others `U`.
+    pub assignment_derived: bool,
     /// `edges_foldsynth:driven`, if present.
     pub driven: Option<Vec<bool>>,
     /// All frames; `frames[0]` is the key frame, `frames[i]` is `file_frames[i-1]`.
@@ -339,7 +346,11 @@ impl Ctx<'_> {
         } else {
             Err(self.err(
                 field,
-                format!("{what} index {i} out of range (there are {n} {what}s, 0-based)"),
+                format!(
+                    "{what} index {i} out of range (there {} {n} {}, 0-based)",
+                    if n == 1 { "is" } else { "are" },
+                    plural(what, n)
+                ),
             ))
         }
     }
@@ -402,6 +413,16 @@ fn kind(v: &Value) -> &'static str {
     }
 }
 
+/// "vertex" → "vertices", "frame" → "frames" (for n ≠ 1).
+fn plural(what: &str, n: usize) -> String {
+    match (what, n) {
+        (w, 1) => w.to_string(),
+        ("vertex", _) => "vertices".to_string(),
+        ("face", _) | ("edge", _) | ("frame", _) => format!("{what}s"),
+        (w, _) => format!("{w} entries"),
+    }
+}
+
 fn short(v: &Value) -> String {
     let s = v.to_string();
     if s.len() > 40 {
@@ -415,7 +436,7 @@ impl FoldFile {
     /// Read a FOLD file from disk.
     pub fn read(path: &Path) -> Result<FoldFile, FoldError> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| FoldError {
+        let text = crate::limits::read_text(path).map_err(|e| FoldError {
             file: name.clone(),
             field: "(file)".into(),
             message: format!("cannot read: {e}"),
@@ -531,6 +552,7 @@ impl FoldFile {
 
         let mut edges_derived = false;
         let mut faces_derived = false;
+        let assignment_derived = assignment.is_none();
         let assignment = match (&mut edges, &mut faces) {
             (None, None) => {
                 return Err(cx.err(
@@ -572,6 +594,19 @@ impl FoldFile {
             }
             (Some(e), Some(_)) => assignment.unwrap_or_else(|| vec![Assignment::U; e.len()]),
         };
+        let mut assignment = assignment;
+        if assignment_derived && !edges_derived {
+            // No assignment: the boundary is where only one face is (FOLD leaves it
+            // to the reader); every other edge is an unassigned crease.
+            if let (Some(e), Some(f)) = (&edges, &faces) {
+                let adj = EdgeFaces::new(e, f);
+                for (i, a) in assignment.iter_mut().enumerate() {
+                    if adj.left[i].len() + adj.right[i].len() == 1 {
+                        *a = Assignment::B;
+                    }
+                }
+            }
+        }
         let edges = edges.unwrap_or_default();
         let faces = faces.unwrap_or_default();
         let ne = edges.len();
@@ -669,6 +704,7 @@ impl FoldFile {
             faces,
             edges_derived,
             faces_derived,
+            assignment_derived,
             driven,
             frames,
             custom,
@@ -908,7 +944,18 @@ fn parse_coords(
         }
         let mut c = [0.0; 3];
         for (k, x) in a.iter().enumerate() {
-            c[k] = cx.number(x, &format!("{field}[{i}][{k}]"))?;
+            let f = format!("{field}[{i}][{k}]");
+            c[k] = cx.number(x, &f)?;
+            if c[k].abs() > crate::limits::COORD_MAX {
+                return Err(cx.err(
+                    f,
+                    format!(
+                        "{} is out of range: coordinates lie within ±{} (larger ones overflow squared distances)",
+                        crate::text::num(c[k]),
+                        crate::text::num(crate::limits::COORD_MAX)
+                    ),
+                ));
+            }
         }
         out.push(c);
     }

@@ -159,11 +159,22 @@ pub(crate) fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
     })
 }
 
+/// Every number finite and within ±[`crate::limits::COORD_MAX`]: larger ones overflow
+/// squared distances (1e308 gives an infinite error that compares as "within bounds").
 fn check_finite(what: impl FnOnce() -> String, xs: &[f64]) -> Result<()> {
-    if xs.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(ExportError::invalid(what(), "non-finite number"))
+    match xs
+        .iter()
+        .find(|x| !(x.is_finite() && x.abs() <= crate::limits::COORD_MAX))
+    {
+        None => Ok(()),
+        Some(x) => Err(ExportError::invalid(
+            what(),
+            format!(
+                "{} is not allowed: numbers must be finite and within ±{}",
+                crate::text::num(*x),
+                crate::text::num(crate::limits::COORD_MAX)
+            ),
+        )),
     }
 }
 
@@ -214,12 +225,7 @@ pub fn validate_pattern(p: &Pattern) -> Result<()> {
         }
     }
     for (j, fr) in p.frames.iter().enumerate() {
-        if !fr.t.is_finite() {
-            return Err(ExportError::invalid(
-                format!("pattern.frames[{j}].t"),
-                "non-finite number",
-            ));
-        }
+        check_finite(|| format!("pattern.frames[{j}].t"), &[fr.t])?;
         if fr.coords.len() != n {
             return Err(ExportError::invalid(
                 format!("pattern.frames[{j}].coords"),
@@ -277,10 +283,14 @@ pub fn validate_meta(meta: &DesignMeta, p: &Pattern) -> Result<()> {
     if let Some(c) = &meta.obstacle {
         check_finite(|| "meta.obstacle.a".into(), &c.a)?;
         check_finite(|| "meta.obstacle.b".into(), &c.b)?;
-        if !(c.radius.is_finite() && c.radius > 0.0) {
+        if !(c.radius.is_finite() && c.radius > 0.0 && c.radius <= crate::limits::COORD_MAX) {
             return Err(ExportError::invalid(
                 "meta.obstacle.radius",
-                format!("{} is not allowed; the radius must be > 0", c.radius),
+                format!(
+                    "{} is not allowed; the radius must be > 0 and at most {}",
+                    crate::text::num(c.radius),
+                    crate::text::num(crate::limits::COORD_MAX)
+                ),
             ));
         }
         if crate::geom::norm(crate::geom::sub(c.b, c.a)) == 0.0 {
@@ -519,21 +529,27 @@ pub struct DesignFile {
 impl DesignFile {
     /// Read and validate a design JSON file.
     pub fn read(path: &Path) -> Result<DesignFile> {
-        let text = std::fs::read_to_string(path).map_err(|source| ExportError::Io {
+        let text = crate::limits::read_text(path).map_err(|source| ExportError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        let d: DesignFile = serde_json::from_str(&text).map_err(|e| {
+        DesignFile::parse(&text, &path.display().to_string())
+    }
+
+    /// Parse and validate design JSON text; `source` names it in messages.
+    pub fn parse(text: &str, source: &str) -> Result<DesignFile> {
+        let d: DesignFile = serde_json::from_str(text).map_err(|e| {
             ExportError::invalid(
-                path.display().to_string(),
+                source,
                 format!(
-                    "not a design file ({e}); expected {{\"pattern\": {{vertices, edges, faces, frames}}, \"meta\": {{task, …}}}}"
+                    "not a design file ({}); expected {{\"pattern\": {{vertices, edges, faces, frames}}, \"meta\": {{task, …}}}}",
+                    crate::text::excerpt(&e.to_string(), 200)
                 ),
             )
         })?;
         validate_pattern(&d.pattern)
             .and_then(|()| validate_meta(&d.meta, &d.pattern))
-            .map_err(|e| ExportError::invalid(path.display().to_string(), e.to_string()))?;
+            .map_err(|e| ExportError::invalid(source, e.to_string()))?;
         Ok(d)
     }
 }

@@ -10,6 +10,7 @@
 //! about z is drawn as well, in its own colours. The scale is fixed over all frames so an
 //! animation does not jump.
 
+use rayon::prelude::*;
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
 
 use super::{DesignMeta, ExportError, Result, validate_meta, validate_pattern};
@@ -72,6 +73,91 @@ const OBSTACLE: Rgba = Rgba(150, 156, 166, 150);
 const OUTLINE: Rgba = Rgba(50, 50, 50, 255);
 const TARGET: Rgba = Rgba(220, 30, 30, 255);
 const TRAJECTORY: Rgba = Rgba(20, 150, 60, 255);
+const PROGRESS: Rgba = Rgba(80, 80, 80, 255);
+const AXES: [Rgba; 3] = [
+    Rgba(200, 40, 40, 255),
+    Rgba(40, 150, 40, 255),
+    Rgba(40, 70, 200, 255),
+];
+/// Lightest shade of a facet ([`Scene::items`] shades by `0.45 + 0.55·|n·light|`).
+const SHADE_MIN: f64 = 0.45;
+
+/// The GIF palette: the colours this renderer draws with (every shade of the four paper
+/// colours, the obstacle over white, greys for white, outline and the progress bar, the
+/// accents and their blends with white, the papers' blends with the outline) and a coarse
+/// colour cube for the anti-aliased rest, with a 32³ table from colour to index.
+pub struct GifPalette {
+    /// `[r, g, b]` per entry, 256 entries.
+    pub rgb: Vec<u8>,
+    lut: Vec<u8>,
+}
+
+impl GifPalette {
+    /// The entry for a colour (nearest to the centre of its 32³ table cell).
+    #[inline]
+    pub fn index(&self, r: u8, g: u8, b: u8) -> u8 {
+        self.lut[(usize::from(r >> 3) << 10) | (usize::from(g >> 3) << 5) | usize::from(b >> 3)]
+    }
+
+    /// The colour of entry `i`.
+    pub fn color(&self, i: u8) -> [u8; 3] {
+        let i = 3 * usize::from(i);
+        [self.rgb[i], self.rgb[i + 1], self.rgb[i + 2]]
+    }
+
+    fn build() -> GifPalette {
+        let mut cols: Vec<[u8; 3]> = Vec::with_capacity(256);
+        let rgb = |c: Rgba| [c.0, c.1, c.2];
+        let mix = |a: [u8; 3], b: [u8; 3], t: f64| {
+            [0, 1, 2].map(|i| (a[i] as f64 * (1.0 - t) + b[i] as f64 * t).round() as u8)
+        };
+        let white = [255, 255, 255];
+        let shades = |n: usize| {
+            (0..n).map(move |i| SHADE_MIN + (1.0 - SHADE_MIN) * i as f64 / (n - 1) as f64)
+        };
+        for paper in [FRONT, BACK, FRONT2, BACK2] {
+            cols.extend(shades(32).map(|k| rgb(paper.shade(k))));
+        }
+        let a = OBSTACLE.opacity();
+        cols.extend(shades(12).map(|k| mix(white, rgb(OBSTACLE.shade(k)), a)));
+        cols.extend((0..18).map(|i| {
+            let v = (255.0 * i as f64 / 17.0).round() as u8;
+            [v, v, v]
+        }));
+        for accent in [TARGET, TRAJECTORY, AXES[0], AXES[1], AXES[2]] {
+            cols.push(rgb(accent));
+            cols.push(mix(rgb(accent), white, 0.5));
+        }
+        for paper in [FRONT, BACK, FRONT2, BACK2] {
+            cols.extend(shades(6).map(|k| mix(rgb(paper.shade(k)), rgb(OUTLINE), 0.5)));
+        }
+        for r in 0..4u8 {
+            for g in 0..4u8 {
+                for b in 0..4u8 {
+                    cols.push([r * 85, g * 85, b * 85]);
+                }
+            }
+        }
+        debug_assert_eq!(cols.len(), 256);
+        cols.truncate(256);
+        let mut lut = vec![0u8; 1 << 15];
+        for (cell, entry) in lut.iter_mut().enumerate() {
+            let c = [(cell >> 10) & 31, (cell >> 5) & 31, cell & 31].map(|v| (v * 8 + 4) as i32);
+            let d = |p: &[u8; 3]| (0..3).map(|i| (p[i] as i32 - c[i]).pow(2)).sum::<i32>();
+            *entry = (0..cols.len()).min_by_key(|&i| d(&cols[i])).unwrap_or(0) as u8;
+        }
+        GifPalette {
+            rgb: cols.into_iter().flatten().collect(),
+            lut,
+        }
+    }
+}
+
+/// The palette of every GIF this renderer writes (built once).
+pub fn gif_palette() -> &'static GifPalette {
+    static PALETTE: std::sync::OnceLock<GifPalette> = std::sync::OnceLock::new();
+    PALETTE.get_or_init(GifPalette::build)
+}
 
 /// A 2D item of a picture, in world-projected coordinates (not yet fitted to pixels).
 #[derive(Clone, Debug)]
@@ -214,7 +300,7 @@ impl<'a> Scene<'a> {
             let n = geom::normalize(geom::newell_normal(pts3)).unwrap_or(dir);
             let facing = geom::dot(n, dir) >= 0.0;
             let base = if facing { front } else { back };
-            let k = 0.45 + 0.55 * geom::dot(n, light).abs();
+            let k = SHADE_MIN + (1.0 - SHADE_MIN) * geom::dot(n, light).abs();
             let c = pts3.iter().fold([0.0; 3], |a, &p| geom::add(a, p));
             let depth = self.depth(geom::scale(c, 1.0 / pts3.len() as f64));
             polys.push((
@@ -418,9 +504,9 @@ impl<'a> Scene<'a> {
         let (r, u, _) = self.camera.basis();
         let origin = [24.0, size.1 as f64 - 24.0];
         let axes = [
-            ([1.0, 0.0, 0.0], Rgba(200, 40, 40, 255), "x"),
-            ([0.0, 1.0, 0.0], Rgba(40, 150, 40, 255), "y"),
-            ([0.0, 0.0, 1.0], Rgba(40, 70, 200, 255), "z"),
+            ([1.0, 0.0, 0.0], AXES[0], "x"),
+            ([0.0, 1.0, 0.0], AXES[1], "y"),
+            ([0.0, 0.0, 1.0], AXES[2], "z"),
         ];
         axes.iter()
             .map(|&(a, c, name)| {
@@ -461,6 +547,10 @@ impl<'a> Scene<'a> {
     /// The motion as an animated GIF (looping, with a pause at the end and a progress bar
     /// along the bottom edge): at most `max_frames` frames, evenly picked over the
     /// pattern's frames (first and last included). `delay_cs` is the frame delay in 1/100 s.
+    ///
+    /// The colours are the renderer's own ([`gif_palette`]: one global palette, no
+    /// per-frame quantization), and the frames are drawn, mapped and LZW-compressed in
+    /// parallel; only the byte stream is written in order.
     pub fn gif(&self, size: (u32, u32), delay_cs: u16, max_frames: usize) -> Result<Vec<u8>> {
         Self::check_size(size)?;
         let total = self.pattern.frames.len();
@@ -472,37 +562,50 @@ impl<'a> Scene<'a> {
         }
         let picked = super::picked_frames(total, max_frames.max(2));
         let n = picked.len();
+        let palette = gif_palette();
+        let frames: Vec<gif::Frame<'static>> = picked
+            .par_iter()
+            .enumerate()
+            .map(|(k, &frame_index)| -> Result<gif::Frame<'static>> {
+                let mut pm = self.pixmap(Some(frame_index), size)?;
+                let frac = if n > 1 {
+                    k as f32 / (n - 1) as f32
+                } else {
+                    1.0
+                };
+                if let Some(rect) = tiny_skia::Rect::from_xywh(
+                    0.0,
+                    size.1 as f32 - 4.0,
+                    (size.0 as f32 * frac).max(1.0),
+                    4.0,
+                ) {
+                    let mut p = Paint::default();
+                    p.set_color_rgba8(PROGRESS.0, PROGRESS.1, PROGRESS.2, PROGRESS.3);
+                    pm.fill_rect(rect, &p, Transform::identity(), None);
+                }
+                // Opaque white background: premultiplied RGBA equals straight RGBA here.
+                let indices: Vec<u8> = pm
+                    .data()
+                    .chunks_exact(4)
+                    .map(|px| palette.index(px[0], px[1], px[2]))
+                    .collect();
+                let mut frame =
+                    gif::Frame::from_indexed_pixels(size.0 as u16, size.1 as u16, indices, None);
+                frame.delay = if k + 1 == n {
+                    delay_cs.saturating_mul(8).max(50)
+                } else {
+                    delay_cs
+                };
+                frame.make_lzw_pre_encoded();
+                Ok(frame)
+            })
+            .collect::<Result<_>>()?;
         let img = |e: gif::EncodingError| ExportError::Image(e.to_string());
-        let mut enc =
-            gif::Encoder::new(Vec::new(), size.0 as u16, size.1 as u16, &[]).map_err(img)?;
+        let mut enc = gif::Encoder::new(Vec::new(), size.0 as u16, size.1 as u16, &palette.rgb)
+            .map_err(img)?;
         enc.set_repeat(gif::Repeat::Infinite).map_err(img)?;
-        for (k, &frame_index) in picked.iter().enumerate() {
-            let mut pm = self.pixmap(Some(frame_index), size)?;
-            let frac = if n > 1 {
-                k as f32 / (n - 1) as f32
-            } else {
-                1.0
-            };
-            if let Some(rect) = tiny_skia::Rect::from_xywh(
-                0.0,
-                size.1 as f32 - 4.0,
-                (size.0 as f32 * frac).max(1.0),
-                4.0,
-            ) {
-                let mut p = Paint::default();
-                p.set_color_rgba8(80, 80, 80, 255);
-                pm.fill_rect(rect, &p, Transform::identity(), None);
-            }
-            // Opaque white background: premultiplied RGBA equals straight RGBA here.
-            let mut rgba = pm.take();
-            let mut frame =
-                gif::Frame::from_rgba_speed(size.0 as u16, size.1 as u16, &mut rgba, 30);
-            frame.delay = if k + 1 == n {
-                delay_cs.saturating_mul(8).max(50)
-            } else {
-                delay_cs
-            };
-            enc.write_frame(&frame).map_err(img)?;
+        for frame in &frames {
+            enc.write_lzw_pre_encoded_frame(frame).map_err(img)?;
         }
         enc.into_inner().map_err(img)
     }
@@ -627,6 +730,68 @@ mod tests {
             // z projects upward on screen for |elevation| < 90°.
             assert!(u[2] > 0.0);
         }
+    }
+
+    #[test]
+    fn the_gif_palette_holds_the_renderers_colours() {
+        let pal = gif_palette();
+        assert_eq!(pal.rgb.len(), 3 * 256);
+        let err = |c: [u8; 3]| {
+            let e = pal.color(pal.index(c[0], c[1], c[2]));
+            (0..3)
+                .map(|i| (e[i] as i32 - c[i] as i32).abs())
+                .max()
+                .unwrap_or(0)
+        };
+        // A colour c is within 4√3 of its cell's centre m, and the entry q chosen for m is
+        // no farther from m than the entry e nearest c: |q − c| ≤ |e − c| + 8√3. For an
+        // entry e = c (< 14); for a shade of paper |e − c| ≤ √3·(half a step of 4.3 +
+        // rounding 0.5) (< 19).
+        for paper in [FRONT, BACK, FRONT2, BACK2] {
+            for i in 0..=200 {
+                let k = SHADE_MIN + (1.0 - SHADE_MIN) * i as f64 / 200.0;
+                let c = paper.shade(k);
+                assert!(err([c.0, c.1, c.2]) < 19, "{paper:?} at {k}");
+            }
+        }
+        for c in [
+            OUTLINE, TARGET, TRAJECTORY, PROGRESS, AXES[0], AXES[1], AXES[2],
+        ] {
+            assert!(err([c.0, c.1, c.2]) < 14, "{c:?}");
+        }
+        assert_eq!(pal.color(pal.index(255, 255, 255)), [255, 255, 255]);
+    }
+
+    #[test]
+    fn gif_frames_are_the_pictures_in_the_palette() {
+        let p = samples::single_crease(2.0, 20);
+        let meta = DesignMeta::default();
+        let scene = Scene::new(&p, &meta, Camera::default()).unwrap();
+        let bytes = scene.gif((96, 72), 4, 5).unwrap();
+        let mut opts = gif::DecodeOptions::new();
+        opts.set_color_output(gif::ColorOutput::RGBA);
+        let mut dec = opts.read_info(bytes.as_slice()).unwrap();
+        let picked = super::super::picked_frames(p.frames.len(), 5);
+        let mut k = 0;
+        while let Some(f) = dec.read_next_frame().unwrap() {
+            // The decoded frame is the rendered picture (progress bar aside) up to the
+            // palette: small errors on average, none far off on the paper.
+            let pm = scene.pixmap(Some(picked[k]), (96, 72)).unwrap();
+            let rows = 72 - 4;
+            let mut sum = 0u64;
+            for (a, b) in pm.data()[..96 * rows * 4]
+                .chunks_exact(4)
+                .zip(f.buffer.chunks_exact(4))
+            {
+                for i in 0..3 {
+                    sum += (a[i] as i64 - b[i] as i64).unsigned_abs();
+                }
+            }
+            let mean = sum as f64 / (96 * rows * 3) as f64;
+            assert!(mean < 3.0, "frame {k}: mean error {mean}");
+            k += 1;
+        }
+        assert_eq!(k, picked.len());
     }
 
     #[test]

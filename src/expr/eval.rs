@@ -4,6 +4,7 @@
 use super::graph::ExprGraph;
 use super::node::{Node, NodeId, clamp_unit, select};
 use crate::kinematics::{acos_clamped, sgn_f64};
+use crate::trig;
 
 /// Wrong input or output lengths, or an index out of the declared range.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -236,11 +237,11 @@ impl Tape {
                 Instr::Mul(a, b) => v(a) * v(b),
                 Instr::Div(a, b) => v(a) / v(b),
                 Instr::Neg(a) => -v(a),
-                Instr::Sin(a) => v(a).sin(),
-                Instr::Cos(a) => v(a).cos(),
+                Instr::Sin(a) => trig::sin(v(a)),
+                Instr::Cos(a) => trig::cos(v(a)),
                 Instr::Acos(a) => acos_clamped(v(a)),
                 Instr::Sqrt(a) => v(a).sqrt(),
-                Instr::Atan2(a, b) => v(a).atan2(v(b)),
+                Instr::Atan2(a, b) => trig::atan2(v(a), v(b)),
                 Instr::Sgn(a) => sgn_f64(v(a)),
                 Instr::Clamp(a) => clamp_unit(v(a)),
                 Instr::Select(c, a, b) => select(v(c), v(a), v(b)),

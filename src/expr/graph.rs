@@ -48,7 +48,8 @@ pub(crate) type FxHashMap<K, V> = HashMap<K, V, FxBuild>;
 ///
 /// [`ExprGraph::add`] folds constants and applies a few cheap identities on construction.
 /// Folding never changes a computed value, with one documented exception: the sign of a
-/// zero. `x + 0 → x`, `0 - x → -x` and `x * 0 → 0` may turn `-0.0` into `+0.0` or back;
+/// zero. `x + 0 → x`, `0 - x → -x`, `(-x) - y → -(x + y)` and `x * 0 → 0` may turn `-0.0`
+/// into `+0.0` or back;
 /// the results compare equal (`==`) and only `atan2` and division *at exactly zero* can
 /// tell them apart. `x * 0 → 0` and `x - x → 0` are applied only when the range analysis
 /// proves `x` finite for every finite input (otherwise `inf * 0` would be NaN).
@@ -213,6 +214,12 @@ impl ExprGraph {
                 }
                 if let Some(nb) = self.neg_of(b) {
                     return self.add(Add(a, nb));
+                }
+                if let Some(na) = self.neg_of(a) {
+                    // (-x) - b = -(x + b) exactly (rounding is symmetric), so that
+                    // -(-x - b) becomes x + b.
+                    let s = self.add(Add(na, b));
+                    return self.add(Neg(s));
                 }
                 self.intern(Sub(a, b))
             }

@@ -1,6 +1,7 @@
 //! Node kinds, their f64 semantics and a conservative range analysis.
 
 use crate::kinematics::{acos_clamped, sgn_f64};
+use crate::trig;
 use std::hash::{Hash, Hasher};
 
 /// Index of a node in an [`ExprGraph`](super::ExprGraph) arena.
@@ -210,11 +211,11 @@ impl Node {
             Mul(..) => args[0] * args[1],
             Div(..) => args[0] / args[1],
             Neg(_) => -args[0],
-            Sin(_) => args[0].sin(),
-            Cos(_) => args[0].cos(),
+            Sin(_) => trig::sin(args[0]),
+            Cos(_) => trig::cos(args[0]),
             Acos(_) => acos_clamped(args[0]),
             Sqrt(_) => args[0].sqrt(),
-            Atan2(..) => args[0].atan2(args[1]),
+            Atan2(..) => trig::atan2(args[0], args[1]),
             Sgn(_) => sgn_f64(args[0]),
             Clamp(_) => clamp_unit(args[0]),
             Select(..) => select(args[0], args[1], args[2]),

@@ -13,6 +13,10 @@
 //! code (each vertex's ordered neighbour labels) is a complete invariant computed in linear
 //! time. The mirror image reverses every rotation (p_m … p1, s3 s2 s1) and maps G0's
 //! vertices through the task's mirror map.
+//!
+//! An r2′ sink is never a root of the traversal (it is not in G0) and is reached from one
+//! of its two neighbours, so at most one of them is unlabelled when it is visited: its
+//! neighbour order cannot change the labels, and its code lists them sorted.
 
 use std::collections::VecDeque;
 
@@ -28,6 +32,7 @@ const TAG_FIXED: u32 = u32::MAX - 1;
 const TAG_OPEN: u32 = u32::MAX - 2;
 const TAG_EXTENDED: u32 = u32::MAX - 3;
 const TAG_MARK: u32 = u32::MAX - 4;
+const TAG_SINK: u32 = u32::MAX - 5;
 
 impl CreaseGraph {
     /// The canonical code of this graph.
@@ -95,9 +100,20 @@ impl CreaseGraph {
                 code.push(TAG_FIXED);
                 continue;
             }
+            let pred = |c: &super::Cid| label[self.cr(*c).tail.ix()];
+            if v.sink_between.is_some() {
+                // An r2′ sink: two creases and two straight sectors. With two rays the
+                // rotation reads the same both ways, so the unordered pair of its
+                // neighbours is all there is (in the mirror image too).
+                let mut p: Vec<u32> = v.preds.iter().map(pred).collect();
+                p.sort_unstable();
+                code.push(TAG_SINK);
+                code.push(p.len() as u32);
+                code.extend(p);
+                continue;
+            }
             code.push(if v.extended { TAG_EXTENDED } else { TAG_OPEN });
             code.push(v.preds.len() as u32);
-            let pred = |c: &super::Cid| label[self.cr(*c).tail.ix()];
             let slot = |s: &Option<super::Cid>| s.map_or(NONE, |c| label[self.cr(c).head.ix()]);
             if mirrored {
                 code.extend(v.preds.iter().rev().map(pred));

@@ -2,7 +2,8 @@
 //!
 //! Breadth-first by number of rule applications. From every graph that is expanded, the
 //! r1 matches (while N < N_max) in increasing vertex name, then the r2 matches in
-//! increasing sorted name pairs, each give one child. Every child gets one status:
+//! increasing sorted name pairs, then (only when [`Rules::r2p`] is on) the r2′ matches in
+//! the same order, each give one child. Every child gets one status:
 //!
 //! - `isomorphic`: the same design family as an earlier graph (canonical code, see
 //!   [`Code`](super::Code)); not expanded.
@@ -51,6 +52,89 @@ impl Filters {
             mirror: false,
             validity: false,
         }
+    }
+}
+
+/// Which rules the enumeration applies. The thesis's grammar is r1 and r2 (the default);
+/// r2′ (Sec. 5.7) is opt-in, so the thesis's counts stay what they are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Rules {
+    /// r1: extend a vertex.
+    pub r1: bool,
+    /// r2: combine two vertices.
+    pub r2: bool,
+    /// r2′: combine two vertices into a sink on the straight segment between their
+    /// predecessors (cyclic, overconstrained patterns such as the Miura-ori).
+    pub r2p: bool,
+}
+
+impl Default for Rules {
+    fn default() -> Self {
+        Rules {
+            r1: true,
+            r2: true,
+            r2p: false,
+        }
+    }
+}
+
+impl Rules {
+    /// Every rule, r2′ included.
+    pub fn all() -> Rules {
+        Rules {
+            r1: true,
+            r2: true,
+            r2p: true,
+        }
+    }
+
+    /// Read a comma-separated list such as `r1,r2,r2p` (`r2'` and `r2′` name r2′ too).
+    pub fn parse(text: &str) -> Result<Rules, String> {
+        let mut r = Rules {
+            r1: false,
+            r2: false,
+            r2p: false,
+        };
+        for name in text.split(',').map(str::trim) {
+            match name {
+                "r1" => r.r1 = true,
+                "r2" => r.r2 = true,
+                "r2p" | "r2'" | "r2′" => r.r2p = true,
+                "" => {
+                    return Err(format!(
+                        "\"{text}\": an empty rule name; list rules as r1,r2,r2p"
+                    ));
+                }
+                other => {
+                    return Err(format!(
+                        "\"{other}\" is not a rule; the rules are r1, r2 and r2p (r2′)"
+                    ));
+                }
+            }
+        }
+        if !r.r1 {
+            return Err(format!(
+                "\"{text}\": r1 must be among the rules (without it no vertex is ever extended)"
+            ));
+        }
+        Ok(r)
+    }
+
+    /// The list as [`Rules::parse`] reads it, e.g. `r1,r2,r2p`.
+    pub fn names(&self) -> String {
+        [(self.r1, "r1"), (self.r2, "r2"), (self.r2p, "r2p")]
+            .iter()
+            .filter(|(on, _)| *on)
+            .map(|(_, n)| *n)
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+}
+
+impl std::str::FromStr for Rules {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Rules, String> {
+        Rules::parse(s)
     }
 }
 
@@ -186,6 +270,20 @@ pub struct Enumeration {
     pub filters: Filters,
     /// Whether the mirror filter actually ran (requested and the task is mirror-symmetric).
     pub mirror_applied: bool,
+    /// The rules applied.
+    pub rules: Rules,
+}
+
+/// The search tree grew past the graph budget given to [`Enumeration::run_limited`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the search tree exceeded {limit} graphs at level {level} (N_max = {n_max})")]
+pub struct TooLarge {
+    /// The budget.
+    pub limit: usize,
+    /// The level at which it was exceeded.
+    pub level: usize,
+    /// The N_max requested.
+    pub n_max: usize,
 }
 
 /// One generated graph as [`Enumeration::stream`] hands it over.
@@ -237,22 +335,7 @@ impl Enumeration {
     /// Enumerate all graphs of `task` up to `n_max` internal vertices, keeping every
     /// graph (use [`Enumeration::stream`] for large N_max).
     pub fn run(task: &Task, n_max: usize, filters: Filters) -> Enumeration {
-        let mut nodes = Vec::new();
-        let done = Self::stream(task, n_max, filters, |g| {
-            nodes.push(Node {
-                graph: g.graph.clone(),
-                parent: g.parent,
-                level: g.level,
-                status: g.status,
-            });
-        });
-        Enumeration {
-            root: CreaseGraph::initial(task),
-            nodes,
-            n_max,
-            filters,
-            mirror_applied: done.mirror_applied,
-        }
+        Self::run_with(task, n_max, filters, Rules::default())
     }
 
     /// Generate the graphs of `task` up to `n_max` internal vertices in the order of
@@ -263,8 +346,81 @@ impl Enumeration {
         task: &Task,
         n_max: usize,
         filters: Filters,
-        mut visit: impl FnMut(Generated<'_>),
+        visit: impl FnMut(Generated<'_>),
     ) -> Streamed {
+        Self::stream_with(task, n_max, filters, Rules::default(), visit)
+    }
+
+    /// As [`Enumeration::run`] with a choice of rules (r2′ adds its matches after r2's).
+    pub fn run_with(task: &Task, n_max: usize, filters: Filters, rules: Rules) -> Enumeration {
+        match Self::run_limited_with(task, n_max, filters, rules, usize::MAX) {
+            Ok(e) => e,
+            Err(e) => unreachable!("no budget, yet {e}"),
+        }
+    }
+
+    /// Enumerate keeping at most `max_graphs` graphs (for callers that must stay small,
+    /// such as the fuzzer and the Python binding).
+    pub fn run_limited(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        max_graphs: usize,
+    ) -> Result<Enumeration, TooLarge> {
+        Self::run_limited_with(task, n_max, filters, Rules::default(), max_graphs)
+    }
+
+    /// As [`Enumeration::run_limited`] with a choice of rules.
+    pub fn run_limited_with(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        rules: Rules,
+        max_graphs: usize,
+    ) -> Result<Enumeration, TooLarge> {
+        let mut nodes = Vec::new();
+        let done = Self::stream_limited(task, n_max, filters, rules, max_graphs, |g| {
+            nodes.push(Node {
+                graph: g.graph.clone(),
+                parent: g.parent,
+                level: g.level,
+                status: g.status,
+            });
+        })?;
+        Ok(Enumeration {
+            root: CreaseGraph::initial(task),
+            nodes,
+            n_max,
+            filters,
+            mirror_applied: done.mirror_applied,
+            rules,
+        })
+    }
+
+    /// As [`Enumeration::stream`] with a choice of rules.
+    pub fn stream_with(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        rules: Rules,
+        visit: impl FnMut(Generated<'_>),
+    ) -> Streamed {
+        match Self::stream_limited(task, n_max, filters, rules, usize::MAX, visit) {
+            Ok(s) => s,
+            Err(e) => unreachable!("no budget, yet {e}"),
+        }
+    }
+
+    /// The one generator: streams at most `max_graphs` graphs, then stops with
+    /// [`TooLarge`] before generating a level's children past the budget.
+    fn stream_limited(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        rules: Rules,
+        max_graphs: usize,
+        mut visit: impl FnMut(Generated<'_>),
+    ) -> Result<Streamed, TooLarge> {
         let root = CreaseGraph::initial(task);
         let mirror_applied =
             filters.mirror && task.symmetry.mirror_xz && root.initial_graph().mirror.is_some();
@@ -294,15 +450,34 @@ impl Enumeration {
                 };
                 let parent_index = parent.as_ref().map(|o| o.index);
                 let mut children = Vec::new();
-                for v in g.r1_matches(n_max) {
-                    let mut c = g.clone();
-                    c.extend(v).expect("r1 matches what r1_matches found");
-                    children.push(c);
+                if rules.r1 {
+                    for v in g.r1_matches(n_max) {
+                        let mut c = g.clone();
+                        c.extend(v).expect("r1 matches what r1_matches found");
+                        children.push(c);
+                    }
                 }
-                for (_, m) in g.r2_matches() {
-                    let mut c = g.clone();
-                    c.combine(m).expect("r2 matches what r2_matches found");
-                    children.push(c);
+                if rules.r2 {
+                    for (_, m) in g.r2_matches() {
+                        let mut c = g.clone();
+                        c.combine(m).expect("r2 matches what r2_matches found");
+                        children.push(c);
+                    }
+                }
+                if rules.r2p {
+                    for (_, m) in g.r2p_matches() {
+                        let mut c = g.clone();
+                        c.combine_straight(m)
+                            .expect("r2′ matches what r2p_matches found");
+                        children.push(c);
+                    }
+                }
+                if generated + children.len() > max_graphs {
+                    return Err(TooLarge {
+                        limit: max_graphs,
+                        level,
+                        n_max,
+                    });
                 }
                 for graph in children {
                     let code = code_digest(&graph.canonical_code());
@@ -343,10 +518,10 @@ impl Enumeration {
             }
             frontier = next;
         }
-        Streamed {
+        Ok(Streamed {
             generated,
             mirror_applied,
-        }
+        })
     }
 
     /// The generated graph with this rule sequence, if it was generated.

@@ -82,6 +82,7 @@ impl CreaseGraph {
                 g0: Some(i),
                 g0_coords: Some(v.xy),
                 placement: None,
+                sink_between: None,
             });
             node_of.push(Some(n));
         }
@@ -324,7 +325,8 @@ impl CreaseGraph {
                 closed_after: true,
             }))
             .collect();
-        if !v.extended {
+        if !v.extended && v.sink_between.is_none() {
+            // (An r2′ sink has no open sector: the straight crease closes both sides.)
             // The open sector lies where the first missing slot goes: after the ray just
             // before it (p_m when s1 is missing).
             if let Some(first_missing) = v.slots.iter().position(Option::is_none) {
@@ -521,6 +523,9 @@ impl CreaseGraph {
                         });
                     }
                 }
+                // r2′ closes a straight angle at its sink: nothing to bound (its Eq. 31–32
+                // constraints stay on the creases' ends, measured, as for r2).
+                StepRecord::R2(r) if r.straight.is_some() => {}
                 StepRecord::R2(r) => {
                     if let ConstraintSpec::MergedSector { from, to, .. } = r.constraint {
                         out.push(ConstraintSpec::MergedSector {

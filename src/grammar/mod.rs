@@ -58,6 +58,17 @@
 //!   image equals an earlier graph that was kept); then validity. A graph without an
 //!   extended vertex has no gripping vertex and is invalid.
 //!
+//! # Rule r2′ (Sec. 5.7, Fig. 52b)
+//!
+//! [`CreaseGraph::combine_straight`] combines two χ vertices like r2 but replaces them by a
+//! sink v′ on the straight segment between their predecessors (the thesis leaves the rule a
+//! sketch; our readings): it matches where r2 does, with one predecessor each, neither in
+//! G0, the predecessors not joined by a crease; v′ sits at the midpoint (any point of the
+//! segment gives the same kinematics; the midpoint adds no variable); the two facets on
+//! the far side of the straight crease become one. It is recorded as an [`R2Record`] with
+//! [`Straight`] set and written `(a, b)'`. The enumeration applies it only when asked
+//! ([`Rules`]), after r2's matches, so the thesis's counts below stay.
+//!
 //! # Counts (gripper and robotic arm, G0 of Fig. 40)
 //!
 //! Without filters N_max = 3 gives exactly the thesis's 291 graphs (G0, the root, not
@@ -73,15 +84,17 @@ mod enumerate;
 mod graph;
 mod notation;
 mod rules;
+mod straight;
 
 pub use canon::Code;
 pub use enumerate::{
-    DOT_FOOTER, Enumeration, Filters, Generated, LevelCounts, Node, Status, Streamed, dot_header,
-    dot_node,
+    DOT_FOOTER, Enumeration, Filters, Generated, LevelCounts, Node, Rules, Status, Streamed,
+    TooLarge, dot_header, dot_node,
 };
 pub use graph::{CreaseGraph, FacetBoundary, FacetError};
 pub use notation::{NotationError, Step, format_sequence, parse_sequence};
 pub use rules::{R2Match, RuleError};
+pub use straight::StraightSink;
 
 use serde::{Deserialize, Serialize};
 
@@ -142,8 +155,11 @@ pub struct Vertex {
     pub g0: Option<usize>,
     /// In-plane coordinates given in the task file (G0 vertices only).
     pub g0_coords: Option<[f64; 2]>,
-    /// How r1 placed this vertex (Eq. 28); `None` for G0 vertices.
+    /// How r1 placed this vertex (Eq. 28); `None` for G0 vertices and r2′ sinks.
     pub placement: Option<Placement>,
+    /// For a sink made by r2′: the two vertices (the tails of its incoming creases) on
+    /// whose straight segment it lies, at the midpoint. `None` for every other vertex.
+    pub sink_between: Option<[Vid; 2]>,
 }
 
 impl Vertex {
@@ -387,8 +403,34 @@ pub struct R2Record {
     pub eliminated: Vec<VarId>,
     /// Their geometric substitutes (Eq. 35).
     pub substitutions: Vec<Substitution>,
-    /// The constraint added (Eq. 34).
+    /// The constraint added (Eq. 34). For r2′ the sector it names (at the sink, between
+    /// the two straight halves) is π by construction and is not bounded: see
+    /// [`CreaseGraph::constraints`].
     pub constraint: ConstraintSpec,
+    /// `Some` when this application was r2′ (the combined vertex is a sink on the straight
+    /// segment between the predecessors).
+    pub straight: Option<Straight>,
+}
+
+/// What r2′ did beyond r2 (thesis Sec. 5.7, Fig. 52b): both combined vertices give way to
+/// a new sink v′ at the midpoint of their predecessors, so the two creases into it form
+/// one straight crease folded from both ends; the facets on its far side become one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Straight {
+    /// The new sink v′ (it takes c1's name).
+    pub sink: Vid,
+    /// c1, replaced by v′ (`R2Record::deleted` is c2).
+    pub replaced: Vid,
+    /// c1's placement, removed with it.
+    pub replaced_placement: Option<Placement>,
+    /// The predecessors p1 (of c1) and p2 (of c2): the ends of the straight crease.
+    pub between: [Vid; 2],
+    /// The facet both creases bounded already (closed at v′ by a straight angle).
+    pub inner: FacetId,
+    /// The facet on the far side after the merge (as numbered right after this step).
+    pub outer: FacetId,
+    /// The name of the facet merged into `outer` (it no longer exists).
+    pub merged_name: String,
 }
 
 /// One rule application.

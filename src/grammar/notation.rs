@@ -1,5 +1,6 @@
 //! The thesis's rule-sequence notation (Sec. 5.5.2): `2, 3, (4, 8), 4, (7, 8)` is r1 on v2,
-//! r1 on v3, r2 on v4 and v8, … with the names as they are when each rule applies.
+//! r1 on v3, r2 on v4 and v8, … with the names as they are when each rule applies. A primed
+//! pair is r2′ (Sec. 5.7, Fig. 52b): `2, 3, 4, 8, (9, 14)'` (`′` is read as `'`).
 
 use std::fmt;
 
@@ -15,6 +16,8 @@ pub enum Step {
     /// r2 on the two vertices with these names, written sorted (the larger first only in
     /// the rare case where both roles match and the second one is meant).
     Combine(usize, usize),
+    /// r2′ on the two vertices with these names (written as r2's pairs, with a prime).
+    Straight(usize, usize),
 }
 
 impl fmt::Display for Step {
@@ -22,6 +25,7 @@ impl fmt::Display for Step {
         match self {
             Step::Extend(n) => write!(f, "{n}"),
             Step::Combine(a, b) => write!(f, "({a}, {b})"),
+            Step::Straight(a, b) => write!(f, "({a}, {b})'"),
         }
     }
 }
@@ -64,8 +68,8 @@ pub fn format_sequence(steps: &[Step]) -> String {
         .join(", ")
 }
 
-/// Read a sequence such as `2, 3, (4, 8), 4, (7, 8)` (spaces optional; the empty string is
-/// G0 itself).
+/// Read a sequence such as `2, 3, (4, 8), 4, (7, 8)` or `2, 3, 4, 8, (9, 14)'` (spaces
+/// optional; the empty string is G0 itself).
 pub fn parse_sequence(text: &str) -> Result<Vec<Step>, NotationError> {
     let b = text.as_bytes();
     let mut i = 0;
@@ -93,6 +97,21 @@ pub fn parse_sequence(text: &str) -> Result<Vec<Step>, NotationError> {
             _ => Err(err(start, "vertex names are positive integers")),
         }
     };
+    // Primes right after a pair or a name (ASCII ' or U+2032 ′), counted.
+    let prime = |i: &mut usize| -> usize {
+        let mut k = 0;
+        loop {
+            skip(i);
+            if *i < b.len() && b[*i] == b'\'' {
+                *i += 1;
+            } else if text[*i..].starts_with('′') {
+                *i += '′'.len_utf8();
+            } else {
+                return k;
+            }
+            k += 1;
+        }
+    };
     let mut steps = Vec::new();
     skip(&mut i);
     if i == b.len() {
@@ -117,9 +136,25 @@ pub fn parse_sequence(text: &str) -> Result<Vec<Step>, NotationError> {
             if x == y {
                 return Err(err(i - 1, "a pair needs two different vertices"));
             }
-            steps.push(Step::Combine(x, y));
+            match prime(&mut i) {
+                0 => steps.push(Step::Combine(x, y)),
+                1 => steps.push(Step::Straight(x, y)),
+                _ => {
+                    return Err(err(
+                        i - 1,
+                        "one prime marks r2′: write (a, b) for r2 or (a, b)' for r2′",
+                    ));
+                }
+            }
         } else {
             steps.push(Step::Extend(number(&mut i)?));
+            let at = i;
+            if prime(&mut i) > 0 {
+                return Err(err(
+                    at,
+                    "a prime marks a pair combined by r2′, written (a, b)'; a single name is r1",
+                ));
+            }
         }
         skip(&mut i);
         if i == b.len() {
@@ -139,6 +174,7 @@ impl CreaseGraph {
             .iter()
             .map(|s| match s {
                 StepRecord::R1(r) => Step::Extend(r.name),
+                StepRecord::R2(r) if r.straight.is_some() => Step::Straight(r.names.0, r.names.1),
                 StepRecord::R2(r) => Step::Combine(r.names.0, r.names.1),
             })
             .collect()

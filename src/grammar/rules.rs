@@ -28,7 +28,7 @@ pub struct R2Match {
 
 /// Why r2 does not match (kept allocation-free: the enumeration tests every pair).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum NoR2 {
+pub(super) enum NoR2 {
     Same,
     NotExtendable(Vid),
     HasS1(Vid),
@@ -40,7 +40,7 @@ enum NoR2 {
 }
 
 impl CreaseGraph {
-    fn vname(&self, v: Vid) -> String {
+    pub(super) fn vname(&self, v: Vid) -> String {
         self.name(v)
             .map_or_else(|| format!("(deleted {})", v.0), |n| format!("v{n}"))
     }
@@ -171,6 +171,7 @@ impl CreaseGraph {
                 g0: None,
                 g0_coords: None,
                 placement: Some(placement.clone()),
+                sink_between: None,
             });
             self.node_of.push(Some(node));
             self.order.push(vid);
@@ -300,7 +301,7 @@ impl CreaseGraph {
         FacetId(id as u32)
     }
 
-    fn r2_reason(&self, c1: Vid, c2: Vid) -> Result<(), NoR2> {
+    pub(super) fn r2_reason(&self, c1: Vid, c2: Vid) -> Result<(), NoR2> {
         if c1 == c2 {
             return Err(NoR2::Same);
         }
@@ -356,32 +357,62 @@ impl CreaseGraph {
                 return Err(RuleError(format!("vertex {} does not exist", v.0)));
             }
         }
-        let head = || {
-            format!(
-                "r2 does not match {} and {}",
+        self.r2_reason(c1, c2)
+            .map_err(|why| RuleError(self.r2_message("r2", c1, c2, why)))
+    }
+
+    /// Why r2's match fails, in words (`rule` names the rule: r2 or r2′).
+    pub(super) fn r2_message(&self, rule: &str, c1: Vid, c2: Vid, why: NoR2) -> String {
+        let head = format!(
+            "{rule} does not match {} and {}",
+            self.vname(c1),
+            self.vname(c2)
+        );
+        match why {
+            NoR2::Same => format!("{head}: a vertex cannot be combined with itself"),
+            NoR2::NotExtendable(v) => {
+                format!("{head}: {} is not extendable (type ∅)", self.vname(v))
+            }
+            NoR2::HasS1(v) => format!(
+                "{head}: {} already has an outgoing crease s1 next to its last incoming crease",
+                self.vname(v)
+            ),
+            NoR2::HasS3(v) => format!(
+                "{head}: {} already has an outgoing crease s3 next to its first incoming crease",
+                self.vname(v)
+            ),
+            NoR2::Facets => format!(
+                "{head}: they do not share a facet (F_R of {}'s last incoming crease is {}, F_L of {}'s first is {})",
                 self.vname(c1),
-                self.vname(c2)
-            )
-        };
-        self.r2_reason(c1, c2).map_err(|why| {
-            RuleError(match why {
-                NoR2::Same => format!("{}: a vertex cannot be combined with itself", head()),
-                NoR2::NotExtendable(v) => format!("{}: {} is not extendable (type ∅)", head(), self.vname(v)),
-                NoR2::HasS1(v) => format!("{}: {} already has an outgoing crease s1 next to its last incoming crease", head(), self.vname(v)),
-                NoR2::HasS3(v) => format!("{}: {} already has an outgoing crease s3 next to its first incoming crease", head(), self.vname(v)),
-                NoR2::Facets => format!(
-                    "{}: they do not share a facet (F_R of {}'s last incoming crease is {}, F_L of {}'s first is {})",
-                    head(),
-                    self.vname(c1),
-                    self.facet_name(self.cr(*self.vx(c1).preds.last().expect("χ has preds")).right),
-                    self.vname(c2),
-                    self.facet_name(self.cr(self.vx(c2).preds[0]).left),
+                self.facet_name(
+                    self.cr(*self.vx(c1).preds.last().expect("χ has preds"))
+                        .right
                 ),
-                NoR2::SharedPred(p) => format!("{}: both have predecessor {}", head(), self.vname(p)),
-                NoR2::BothG0 => format!("{}: both belong to the initial graph", head()),
-                NoR2::Ancestor(x, y) => format!("{}: {} is an ancestor of {} (a cycle would form)", head(), self.vname(x), self.vname(y)),
-            })
-        })
+                self.vname(c2),
+                self.facet_name(self.cr(self.vx(c2).preds[0]).left),
+            ),
+            NoR2::SharedPred(p) => format!("{head}: both have predecessor {}", self.vname(p)),
+            NoR2::BothG0 => format!("{head}: both belong to the initial graph"),
+            NoR2::Ancestor(x, y) => format!(
+                "{head}: {} is an ancestor of {} (a cycle would form)",
+                self.vname(x),
+                self.vname(y)
+            ),
+        }
+    }
+
+    /// How a pair is written: sorted, except when both roles match and the second one
+    /// (c1 with the larger name) is meant, so that the notation stays unambiguous.
+    pub(super) fn pair_names(&self, m: R2Match, both_roles: bool) -> (usize, usize) {
+        let (n1, n2) = (
+            self.name(m.c1).expect("living"),
+            self.name(m.c2).expect("living"),
+        );
+        if n1 > n2 && both_roles {
+            (n1, n2)
+        } else {
+            (n1.min(n2), n1.max(n2))
+        }
     }
 
     /// Rule r2: combine `m.c2` into `m.c1` (or `m.c1` into `m.c2` when only `m.c2` is in G0):
@@ -390,17 +421,7 @@ impl CreaseGraph {
     /// Records Eq. 34 and the variables eliminated with their substitutes (Eq. 35).
     pub fn combine(&mut self, m: R2Match) -> Result<(), RuleError> {
         self.check_combine(m.c1, m.c2)?;
-        let (n1, n2) = (
-            self.name(m.c1).expect("living"),
-            self.name(m.c2).expect("living"),
-        );
-        // Pairs are written sorted; only when both roles match is the second one written
-        // with the larger name first, so that the notation stays unambiguous.
-        let names = if n1 > n2 && self.r2_reason(m.c2, m.c1).is_ok() {
-            (n1, n2)
-        } else {
-            (n1.min(n2), n1.max(n2))
-        };
+        let names = self.pair_names(m, self.r2_reason(m.c2, m.c1).is_ok());
         let a = self.vx(m.c1).clone();
         let b = self.vx(m.c2).clone();
         let (survivor, deleted) = if b.in_g0() && !a.in_g0() {
@@ -462,13 +483,14 @@ impl CreaseGraph {
                 from,
                 to,
             },
+            straight: None,
         }));
         Ok(())
     }
 
     /// Eq. 35: an eliminated variable in terms of the coordinates, from the placement of the
     /// crease it was created for.
-    fn substitute(&self, var: VarId) -> Substitution {
+    pub(super) fn substitute(&self, var: VarId) -> Substitution {
         let v = &self.variables[var.0 as usize];
         if v.kind == VarKind::Length {
             return Substitution::Length {
@@ -566,10 +588,11 @@ impl CreaseGraph {
                 };
                 self.combine(m)
             }
+            Step::Straight(x, y) => self.apply_straight(x, y),
         }
     }
 
-    fn no_vertex(&self, n: usize) -> RuleError {
+    pub(super) fn no_vertex(&self, n: usize) -> RuleError {
         RuleError(format!(
             "there is no vertex v{n} (the graph has v1 … v{})",
             self.order.len()

@@ -22,14 +22,18 @@ pub struct NotationError {
 
 impl fmt::Display for NotationError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let col = self.input[..self.pos.min(self.input.len())].chars().count();
+        let col = self.input[..self.input.floor_char_boundary(self.pos)]
+            .chars()
+            .count();
+        // A long input is shown as a window around the error, not echoed whole.
+        let (shown, at) = crate::text::window(&self.input, col, 80);
         write!(
             f,
             "{} (at column {})\n  {}\n  {}^",
             self.message,
             col + 1,
-            self.input,
-            " ".repeat(col)
+            shown,
+            " ".repeat(at)
         )
     }
 }
@@ -58,6 +62,7 @@ pub enum DriveExpr {
 impl DriveExpr {
     /// Parse a whole string as an expression in `t`.
     pub fn parse(text: &str) -> Result<DriveExpr, NotationError> {
+        size_check(text)?;
         let mut p = Parser::new(text);
         let e = p.expr()?;
         p.skip_ws();
@@ -166,6 +171,7 @@ impl VertexSpec {
     /// Parse and validate a vertex: every sector in (0°, 180°), a unit of m sectors has
     /// m − 1 driving angles, at least 4 sectors in all.
     pub fn parse(text: &str) -> Result<VertexSpec, NotationError> {
+        size_check(text)?;
         let mut p = Parser::new(text);
         let spec = p.vertex()?;
         p.skip_ws();
@@ -224,6 +230,15 @@ impl fmt::Display for VertexSpec {
         }
         write!(f, ")")
     }
+}
+
+/// Refuse inputs too deeply nested or too long for the recursive parser and evaluator.
+fn size_check(text: &str) -> Result<(), NotationError> {
+    crate::limits::check_expression(text).map_err(|(at, message)| NotationError {
+        input: text.to_string(),
+        pos: text.char_indices().nth(at).map_or(text.len(), |(b, _)| b),
+        message,
+    })
 }
 
 /// A small recursive-descent parser over the notation.
@@ -364,7 +379,13 @@ impl<'a> Parser<'a> {
         let mode_pos = self.pos;
         let word = self.word();
         let mode = Mode::parse(word).ok_or_else(|| {
-            self.error_at(mode_pos, format!("unknown mode '{word}': use up or down"))
+            self.error_at(
+                mode_pos,
+                format!(
+                    "unknown mode '{}': use up or down",
+                    crate::text::excerpt(word, 40)
+                ),
+            )
         })?;
         let mut units = Vec::with_capacity(3);
         for k in 0..3 {
@@ -463,7 +484,13 @@ impl<'a> Parser<'a> {
             let at = self.pos;
             let a = self.number()?;
             if !(a > 0.0 && a < 180.0) {
-                return Err(self.error_at(at, format!("sector angle {a}° is outside (0°, 180°)")));
+                return Err(self.error_at(
+                    at,
+                    format!(
+                        "sector angle {}° is outside (0°, 180°)",
+                        crate::text::num(a)
+                    ),
+                ));
             }
             out.push(a);
             if !self.eat(',') {
@@ -532,10 +559,13 @@ impl<'a> Parser<'a> {
                 match name {
                     "t" => Ok(DriveExpr::T),
                     "pi" | "π" | "Pi" | "PI" => Ok(DriveExpr::Num(std::f64::consts::PI)),
-                    _ => {
-                        Err(self
-                            .error_at(at, format!("unknown name '{name}': use t, pi or numbers")))
-                    }
+                    _ => Err(self.error_at(
+                        at,
+                        format!(
+                            "unknown name '{}': use t, pi or numbers",
+                            crate::text::excerpt(name, 40)
+                        ),
+                    )),
                 }
             }
             Some(c) => Err(self.error(format!("expected a number, t, pi or '(', found '{c}'"))),

@@ -3,6 +3,8 @@
 //! The PTU code is written once, generic over [`Scalar`]: `f64` gives the numeric
 //! reference, the expression-graph handle (`expr`) builds symbolic models from the very
 //! same code, and the dual number (`compile::dual`) is an independent gradient oracle.
+//! `f64`'s `sin`, `cos`, `atan2` and `acos` are [`crate::trig`]'s, the functions the
+//! interpreter and the compiled code use, so all of them compute the same bits.
 
 use std::fmt::Debug;
 use std::ops::{Add, Div, Mul, Neg, Sub};
@@ -67,7 +69,7 @@ pub fn sgn_f64(x: f64) -> f64 {
 /// Arccosine with the argument clamped to `[-1, 1]`, shared by every implementation.
 #[inline]
 pub fn acos_clamped(x: f64) -> f64 {
-    x.clamp(-1.0, 1.0).acos()
+    crate::trig::acos(x)
 }
 
 impl Scalar for f64 {
@@ -77,11 +79,11 @@ impl Scalar for f64 {
     }
     #[inline]
     fn sin(&self) -> Self {
-        f64::sin(*self)
+        crate::trig::sin(*self)
     }
     #[inline]
     fn cos(&self) -> Self {
-        f64::cos(*self)
+        crate::trig::cos(*self)
     }
     #[inline]
     fn acos(&self) -> Self {
@@ -93,7 +95,7 @@ impl Scalar for f64 {
     }
     #[inline]
     fn atan2(&self, x: &Self) -> Self {
-        f64::atan2(*self, *x)
+        crate::trig::atan2(*self, *x)
     }
     #[inline]
     fn sgn(&self) -> Self {

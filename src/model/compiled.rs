@@ -4,10 +4,10 @@
 
 use super::{Model, geometry};
 use crate::compile::{self, Compiled, Options};
+use crate::cpu_time::Stopwatch;
 use crate::expr::{Ctx, Sym};
 use crate::optimize::{Evaluation, Problem};
 use std::cell::RefCell;
-use std::time::Instant;
 
 /// A compiled [`Model`].
 #[derive(Debug)]
@@ -20,10 +20,11 @@ pub struct CompiledModel {
     pub n_constraints: usize,
     /// Number of internal vertices (mode parameters come first).
     pub n_modes: usize,
-    /// Milliseconds to build the expression graph.
+    /// Milliseconds to build the expression graph (CPU time of the compiling thread, as
+    /// the compile report's stages).
     pub build_ms: f64,
     /// Milliseconds from the start of the build to native code (build, simplify,
-    /// differentiate, compile).
+    /// differentiate, compile; CPU time).
     pub total_ms: f64,
 }
 
@@ -45,11 +46,11 @@ pub fn symbolic(model: &Model) -> (Ctx, Vec<Sym>) {
 impl CompiledModel {
     /// Build, simplify, differentiate and compile `model`.
     pub fn new(model: &Model, opts: &Options) -> Result<CompiledModel, compile::CompileError> {
-        let start = Instant::now();
+        let start = Stopwatch::start();
         let (ctx, outputs) = symbolic(model);
         let ids: Vec<_> = outputs.iter().map(|s| ctx.node_id(s)).collect();
         let graph = ctx.to_graph();
-        let build_ms = start.elapsed().as_secs_f64() * 1e3;
+        let build_ms = start.cpu_ms();
         let n_params = model.plan.internal.len() + model.times.len();
         let compiled = compile::compile(&graph, &ids, model.free.len(), n_params, opts)?;
         Ok(CompiledModel {
@@ -58,7 +59,7 @@ impl CompiledModel {
             n_modes: model.plan.internal.len(),
             compiled,
             build_ms,
-            total_ms: start.elapsed().as_secs_f64() * 1e3,
+            total_ms: start.cpu_ms(),
         })
     }
 
@@ -110,14 +111,14 @@ pub struct CompiledMotion {
     pub compiled: Compiled,
     /// Number of vertices.
     pub n_vertices: usize,
-    /// Milliseconds from the start of the build to native code.
+    /// Milliseconds from the start of the build to native code (CPU time).
     pub total_ms: f64,
 }
 
 impl CompiledMotion {
     /// Build, simplify and compile the motion of `model`'s graph.
     pub fn new(model: &Model, opts: &Options) -> Result<CompiledMotion, compile::CompileError> {
-        let start = Instant::now();
+        let start = Stopwatch::start();
         let ctx = Ctx::new();
         let t = ctx.var(0);
         let nf = model.free.len();
@@ -143,7 +144,7 @@ impl CompiledMotion {
         Ok(CompiledMotion {
             compiled,
             n_vertices,
-            total_ms: start.elapsed().as_secs_f64() * 1e3,
+            total_ms: start.cpu_ms(),
         })
     }
 

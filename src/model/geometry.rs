@@ -103,6 +103,19 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
                 pos.push(p);
                 ang.push(Some(a));
             }
+            // Filled below: an r2′ sink may be named before one of its ends.
+            Position::Between { .. } => {
+                pos.push([S::from_f64(0.0), S::from_f64(0.0)]);
+                ang.push(None);
+            }
+        }
+    }
+    for (i, v) in plan.vertices.iter().enumerate() {
+        if let Position::Between { a, b } = v.position {
+            pos[i] = [
+                (pos[a][0].clone() + pos[b][0].clone()) * 0.5,
+                (pos[a][1].clone() + pos[b][1].clone()) * 0.5,
+            ];
         }
     }
     let mut dirs = Vec::with_capacity(n);

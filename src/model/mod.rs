@@ -7,12 +7,15 @@
 //! constraints ψ, and the choice of gripping vertex. The same code runs in `f64` (the
 //! numeric path that verification and export read) and on symbols (the compiled model).
 
+pub mod clearance;
 pub mod compiled;
+pub mod cycle;
 pub mod geometry;
 pub mod interface;
 pub mod linalg;
 pub mod numeric;
 pub mod plan;
+pub mod robust;
 
 pub use plan::{Constraint, Plan, PlanError};
 
@@ -81,7 +84,8 @@ pub struct Model {
     /// Variables of the optimization (Φ_opt): indices into `plan.variables` that the
     /// objective or a constraint depends on. The others are drawn at their lower bound.
     pub free: Vec<usize>,
-    /// The distinct values of t the model evaluates: `t_max` first, then the targets'.
+    /// The distinct values of t the model evaluates: `t_max` first, then the targets', then
+    /// (for cyclic patterns) the compatibility states of [`cycle::states`].
     pub times: Vec<f64>,
 }
 
@@ -133,6 +137,13 @@ impl Model {
         for t in &targets {
             if !times.contains(&t.t) {
                 times.push(t.t);
+            }
+        }
+        if !plan.sinks.is_empty() {
+            for t in cycle::states(t_max) {
+                if !times.contains(&t) {
+                    times.push(t);
+                }
             }
         }
         let mut model = Model {
@@ -226,7 +237,8 @@ impl Model {
                 acc + (d2.clone() + DISTANCE_SMOOTHING * DISTANCE_SMOOTHING).sqrt() * *w
             })
         };
-        let constraints = self.constraints(&flat, &folded[0]);
+        let mut constraints = self.constraints(&flat, &folded[0]);
+        constraints.extend(cycle::constraints(self, &flat, &folded));
         Outputs {
             objective,
             constraints,
@@ -294,6 +306,11 @@ impl Model {
     /// A readable label of constraint `i`.
     pub fn constraint_label(&self, i: usize) -> String {
         let p = &self.plan;
+        if let Some(j) = i.checked_sub(p.constraints.len())
+            && j < cycle::count(self)
+        {
+            return cycle::label(self, j);
+        }
         match &p.constraints[i] {
             Constraint::Sector {
                 vertex,

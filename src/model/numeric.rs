@@ -3,6 +3,7 @@
 //! and export.
 
 use super::geometry::{self, Flat, Folded};
+use super::linalg;
 use super::plan::Plan;
 use crate::kinematics::wrap_angle;
 use crate::pattern::{Edge, EdgeKind, Frame, Pattern};
@@ -34,7 +35,23 @@ impl<'a> Evaluated<'a> {
 
     /// The folded state at `t`.
     pub fn fold(&self, t: f64) -> Folded<f64> {
-        geometry::fold(self.plan, &self.flat, &self.modes, &t)
+        let mut folded = geometry::fold(self.plan, &self.flat, &self.modes, &t);
+        // The flat state of a cyclic pattern (r2′) is flat by definition: every fold angle
+        // 0, every facet map the identity. There a flat-foldable vertex (the Miura-ori's)
+        // has a doubly degenerate triangle (zero area, perimeter 2π) and the PTU's φ is
+        // undefined; the sweep skips that state, but frames and exports start from it.
+        if !self.plan.sinks.is_empty()
+            && self
+                .plan
+                .creases
+                .iter()
+                .all(|c| c.drive.as_ref().is_none_or(|d| d.eval(&t) == 0.0))
+        {
+            folded.rho.iter_mut().for_each(|r| *r = 0.0);
+            folded.rot.iter_mut().for_each(|r| *r = linalg::identity());
+            folded.trans.iter_mut().for_each(|c| *c = [0.0; 3]);
+        }
+        folded
     }
 
     /// 3D position of every vertex at the folded state `folded`.

@@ -30,6 +30,14 @@ pub enum Position {
         /// The crease parent → this vertex.
         crease: usize,
     },
+    /// An r2′ sink: the midpoint of the segment between two vertices (its predecessors),
+    /// so that the two creases into it form one straight crease.
+    Between {
+        /// One end (the predecessor of the replaced c1).
+        a: usize,
+        /// The other end (the predecessor of c2).
+        b: usize,
+    },
 }
 
 /// One crease leaving a vertex, seen from that vertex.
@@ -105,6 +113,22 @@ pub struct WalkStep {
     pub vertex: usize,
     /// Index into that vertex's rays.
     pub ray: usize,
+}
+
+/// A cycle closed by r2′: the sink `vertex` on the straight crease `ends[0]` → sink ←
+/// `ends[1]`, folded by both ends' PTU (thesis Sec. 5.7, Fig. 52b).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sink {
+    /// The sink.
+    pub vertex: usize,
+    /// The two ends (internal vertices), p1 and p2.
+    pub ends: [usize; 2],
+    /// The creases p1 → sink and p2 → sink.
+    pub creases: [usize; 2],
+    /// The facet the two creases closed (right of p1 → sink).
+    pub inner: usize,
+    /// The merged facet on the far side (left of p1 → sink).
+    pub outer: usize,
 }
 
 /// A design variable.
@@ -197,6 +221,8 @@ pub struct Plan {
     pub constraints: Vec<Constraint>,
     /// The three successors of the vertex extended last (gripping candidates).
     pub candidates: Option<[usize; 3]>,
+    /// The cycles r2′ closed (empty for the thesis's acyclic grammar).
+    pub sinks: Vec<Sink>,
 }
 
 impl Plan {
@@ -310,6 +336,13 @@ impl Builder {
                     }
                 }
                 (None, Some(xy)) => Position::Fixed(xy),
+                (None, None) if v.sink_between.is_some() => {
+                    let [a, b] = v.sink_between.expect("checked");
+                    Position::Between {
+                        a: self.v(a)?,
+                        b: self.v(b)?,
+                    }
+                }
                 (None, None) => {
                     return Err(PlanError(format!("vertex {:?} has no position", v.vid)));
                 }
@@ -483,6 +516,25 @@ impl Builder {
             }
         }
         constraints.dedup();
+        let mut sinks = Vec::new();
+        for (i, v) in vertices.iter().enumerate() {
+            if let Position::Between { a, b } = v.position {
+                let (c1, c2) = (v.rays[0].crease, v.rays[1].crease);
+                if creases[c1].tail != a || creases[c2].tail != b {
+                    return Err(PlanError(format!(
+                        "the sink v{} is not fed by its two ends",
+                        v.name
+                    )));
+                }
+                sinks.push(Sink {
+                    vertex: i,
+                    ends: [a, b],
+                    creases: [c1, c2],
+                    inner: creases[c1].right,
+                    outer: creases[c1].left,
+                });
+            }
+        }
         let candidates = match graph.gripping_candidates() {
             Some(c) => Some([self.v(c[0])?, self.v(c[1])?, self.v(c[2])?]),
             None => None,
@@ -507,6 +559,7 @@ impl Builder {
             variables,
             constraints,
             candidates,
+            sinks,
         })
     }
 
@@ -576,6 +629,10 @@ fn sector_rules(
     } else {
         0
     };
+    if let Position::Between { .. } = v.position {
+        // The straight crease through an r2′ sink: its sector is a straight angle.
+        return Ok(vec![Sector::Constant(std::f64::consts::PI); count]);
+    }
     let fixed = |u: usize| matches!(vertices[u].position, Position::Fixed(_));
     let mut out = Vec::with_capacity(count);
     for k in 0..count {

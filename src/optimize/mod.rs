@@ -11,6 +11,13 @@
 //!
 //! The optimizer sees the problem only through [`Problem::eval`] (objective, constraints
 //! and their gradients in one call), i.e. the compiled model.
+//!
+//! [`minimize_robust`] adds a second phase for constraints the problem keeps itself (a
+//! [`Robust`] block: clearances and margins over the motion, issue 12): a start first
+//! solves the plain problem (phase A, exactly [`minimize`]); when that meets the target
+//! but violates the block, the same augmented Lagrangian continues from there with the
+//! block's terms in the merit (phase B: lazily added active constraints, warm-started
+//! from the unconstrained optimum). A start counts only when the block accepts it.
 
 use argmin::core::{CostFunction, Error, Executor, Gradient, State};
 use argmin::solver::linesearch::MoreThuenteLineSearch;
@@ -30,6 +37,45 @@ pub trait Problem {
     /// Evaluate at `x`: the objective, its gradient (length n), the constraints (length m)
     /// and their Jacobian (m × n, row-major) into `out`.
     fn eval(&self, x: &[f64], out: &mut Evaluation);
+}
+
+/// Constraints `h_k(x, z) ≥ 0` a problem keeps itself, with their own multipliers and
+/// their own unbounded variables `z` (separating planes): many, and changing between outer
+/// iterations (active sets, planes refitted), so they reach the optimizer as a term of the
+/// augmented-Lagrangian merit rather than as rows of [`Evaluation`], and `z` joins the
+/// design variables in each L-BFGS run. The block uses the same penalty
+/// `Σ (max(0, λ_k − μ h_k)² − λ_k²)/2μ` and update `λ_k ← max(0, λ_k − μ h_k)` as the
+/// optimizer's own constraints.
+pub trait Robust {
+    /// Forget the multipliers and active sets of an earlier start.
+    fn reset(&self);
+    /// End of an outer iteration at `x`: with `mu`, update the multipliers from the
+    /// constraints the last subproblem saw; then refit (active sets, planes) for the next
+    /// one. Returns the largest violation `max(0, −min h)` after the refit.
+    fn update(&self, x: &[f64], mu: Option<f64>) -> f64;
+    /// The block's own variables for the next subproblem (their number may change at each
+    /// [`Robust::update`]).
+    fn variables(&self) -> Vec<f64>;
+    /// Keep the block's variables a subproblem ended with.
+    fn set_variables(&self, z: &[f64]);
+    /// The block's merit at `x`, `z` with penalty `mu`; adds its gradients into `grad_x`
+    /// and `grad_z`.
+    fn merit(&self, x: &[f64], z: &[f64], mu: f64, grad_x: &mut [f64], grad_z: &mut [f64]) -> f64;
+    /// Whether `x`, feasible at the states sampled so far, also holds on the block's finer
+    /// sweep; if not, the offending states are added (and fitted) for the next outer
+    /// iterations, or the start is given up.
+    fn accept(&self, x: &[f64]) -> Acceptance;
+}
+
+/// What [`Robust::accept`] decided.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Acceptance {
+    /// The point holds everywhere the block looks.
+    Accepted,
+    /// It does not; states were added where it fails: optimize on.
+    Refined,
+    /// It does not, and more states will not help (e.g. a facet flipped between states).
+    Rejected,
 }
 
 /// One evaluation of a [`Problem`].
@@ -80,6 +126,13 @@ pub struct Options {
     /// A start has converged when it is feasible and an outer iteration changes the
     /// objective by less than this, relative to `1 + |f|`.
     pub rel_tol: f64,
+    /// Phase B ([`minimize_robust`]): augmented-Lagrangian iterations.
+    pub robust_outer: usize,
+    /// Phase B: L-BFGS iterations per subproblem.
+    pub robust_inner: u64,
+    /// Phase B is tried on at most this many starts per problem (later starts still run
+    /// phase A and count when the block accepts them as they are).
+    pub robust_starts: usize,
 }
 
 impl Default for Options {
@@ -92,6 +145,9 @@ impl Default for Options {
             feasibility_tol: 1e-9,
             target: None,
             rel_tol: 1e-10,
+            robust_outer: 20,
+            robust_inner: 100,
+            robust_starts: 4,
         }
     }
 }
@@ -111,6 +167,12 @@ pub struct Solution {
     pub feasible: bool,
     /// Whether a feasible point met the target.
     pub met_target: bool,
+    /// With a [`Robust`] block: whether the block accepted the point.
+    pub robust: Option<bool>,
+    /// With a [`Robust`] block: its largest violation at the point.
+    pub robust_violation: Option<f64>,
+    /// Starts on which phase B ran.
+    pub robust_attempts: usize,
     /// Which start produced it.
     pub start: usize,
     /// Starts run.
@@ -191,6 +253,9 @@ impl Transform {
 /// The augmented Lagrangian of one subproblem, as argmin sees it.
 struct Merit<'a, P: Problem> {
     problem: &'a P,
+    robust: Option<&'a dyn Robust>,
+    /// Number of design variables; the block's variables follow them.
+    n: usize,
     transform: &'a Transform,
     lambda: &'a [f64],
     mu: f64,
@@ -207,6 +272,7 @@ impl<P: Problem> Merit<'_, P> {
                 return (c.1, c.2.clone());
             }
         }
+        let (y, z) = y.split_at(self.n);
         let x = self.transform.x(y);
         let mut e = self.work.borrow_mut();
         self.problem.eval(&x, &mut e);
@@ -214,6 +280,7 @@ impl<P: Problem> Merit<'_, P> {
         let n = x.len();
         let mut value = e.f;
         let mut grad = e.df.clone();
+        let mut grad_z = vec![0.0; z.len()];
         for (k, g) in e.g.iter().enumerate() {
             let a = (self.lambda[k] - self.mu * g).max(0.0);
             value += (a * a - self.lambda[k] * self.lambda[k]) / (2.0 * self.mu);
@@ -223,16 +290,21 @@ impl<P: Problem> Merit<'_, P> {
                 }
             }
         }
+        if let Some(r) = self.robust {
+            value += r.merit(&x, z, self.mu, &mut grad, &mut grad_z);
+        }
         let dxdy = self.transform.dx_dy(y);
         for (g, d) in grad.iter_mut().zip(&dxdy) {
             *g *= d;
         }
+        grad.extend(grad_z);
         if !value.is_finite() || grad.iter().any(|g| !g.is_finite()) {
             // Outside where the model is defined: a wall the line search backs off from.
             value = 1e30;
             grad.iter_mut().for_each(|g| *g = 0.0);
         }
-        *self.cache.borrow_mut() = (y.to_vec(), value, grad.clone());
+        let key: Vec<f64> = y.iter().chain(z).copied().collect();
+        *self.cache.borrow_mut() = (key, value, grad.clone());
         (value, grad)
     }
 }
@@ -272,15 +344,126 @@ fn lbfgs<P: Problem>(merit: Merit<'_, P>, y0: Vec<f64>, max_iters: u64, rel_tol:
     }
 }
 
+/// The state of one start's augmented Lagrangian, carried from phase A into phase B.
+struct Lagrangian<'a, P: Problem> {
+    problem: &'a P,
+    transform: &'a Transform,
+    opts: &'a Options,
+    counter: &'a Cell<usize>,
+    y: Vec<f64>,
+    lambda: Vec<f64>,
+    mu: f64,
+    eval: Evaluation,
+    evaluations: usize,
+}
+
+impl<P: Problem> Lagrangian<'_, P> {
+    /// Outer iterations; with `robust`, its terms join the merit and a feasible point that
+    /// meets the target must also pass [`Robust::accept`]. Returns whether it did.
+    fn run(&mut self, robust: Option<&dyn Robust>, max_outer: usize, max_inner: u64) -> bool {
+        let opts = self.opts;
+        let m = self.lambda.len();
+        let n = self.y.len();
+        let mut prev_violation = f64::INFINITY;
+        let mut prev_f = f64::INFINITY;
+        // Phase B gives up on a start that stalls: infeasible with a violation that no
+        // longer shrinks under a stiff penalty, or feasible at a local minimum short of the
+        // target.
+        let mut history: Vec<(f64, f64)> = Vec::new();
+        for _ in 0..max_outer {
+            let merit = Merit {
+                problem: self.problem,
+                robust,
+                n,
+                transform: self.transform,
+                lambda: &self.lambda,
+                mu: self.mu,
+                cache: RefCell::new((Vec::new(), 0.0, Vec::new())),
+                work: RefCell::new(Evaluation::new(n, m)),
+                evaluations: self.counter,
+            };
+            let mut yz = self.y.clone();
+            if let Some(r) = robust {
+                yz.extend(r.variables());
+            }
+            let yz = lbfgs(merit, yz, max_inner, opts.rel_tol);
+            self.y = yz[..n].to_vec();
+            if let Some(r) = robust {
+                r.set_variables(&yz[n..]);
+            }
+            let x = self.transform.x(&self.y);
+            self.problem.eval(&x, &mut self.eval);
+            self.evaluations += 1;
+            let mut violation = self.eval.violation();
+            for (l, g) in self.lambda.iter_mut().zip(&self.eval.g) {
+                *l = (*l - self.mu * g).max(0.0);
+            }
+            if let Some(r) = robust {
+                violation = violation.max(r.update(&x, Some(self.mu)));
+            }
+            let f = self.eval.f;
+            if violation <= opts.feasibility_tol {
+                if opts.target.is_some_and(|t| f <= t) {
+                    let acc = robust.map(|r| r.accept(&x));
+                    match acc {
+                        None | Some(Acceptance::Accepted) => return true,
+                        Some(Acceptance::Rejected) => return false,
+                        // States were added: keep going with them.
+                        Some(Acceptance::Refined) => {
+                            prev_violation = f64::INFINITY;
+                            prev_f = f;
+                            continue;
+                        }
+                    }
+                }
+                // Converged: feasible, and the last outer step no longer moves f.
+                if (f - prev_f).abs() <= opts.rel_tol * (1.0 + f.abs()) {
+                    break;
+                }
+            } else if violation > 0.25 * prev_violation {
+                self.mu = (self.mu * 10.0).min(1e9);
+            }
+            if robust.is_some() {
+                history.push((f, violation));
+                let k = history.len();
+                let far = opts.target.is_some_and(|t| f > 1e4 * t.max(1e-300));
+                // A plateau short of the target (feasible or not): f has not improved by
+                // a tenth over two outer iterations.
+                if far && k >= 3 && f >= 0.9 * history[k - 3].0 {
+                    return false;
+                }
+                // Infeasible, and the violation no longer shrinks.
+                if violation > opts.feasibility_tol && k >= 4 && violation > 0.9 * history[k - 4].1
+                {
+                    return false;
+                }
+            }
+            prev_violation = violation;
+            prev_f = f;
+        }
+        false
+    }
+}
+
 /// Minimize `problem` from many starts (see the module docs).
 pub fn minimize<P: Problem>(problem: &P, opts: &Options) -> Solution {
+    minimize_robust(problem, None, opts)
+}
+
+/// Minimize `problem` from many starts with an optional [`Robust`] block (phase B, see the
+/// module docs). Without the block this is [`minimize`].
+pub fn minimize_robust<P: Problem>(
+    problem: &P,
+    robust: Option<&dyn Robust>,
+    opts: &Options,
+) -> Solution {
     let (n, m) = (problem.n_vars(), problem.n_constraints());
     let (lo, hi): (Vec<f64>, Vec<f64>) = (0..n).map(|i| problem.bounds(i)).unzip();
     let transform = Transform { lo, hi };
-    let mut eval = Evaluation::new(n, m);
     let mut best: Option<Solution> = None;
     let counter = Cell::new(0usize);
     let mut evaluations = 0;
+    let mut attempts = 0;
     let points = quasi_random_points(n, opts.starts, opts.seed);
     for (start, u) in points.iter().enumerate() {
         // Starting points stay off the bounds, where the transform's slope vanishes.
@@ -292,45 +475,48 @@ pub fn minimize<P: Problem>(problem: &P, opts: &Options) -> Solution {
                 l + (h - l) * (0.02 + 0.96 * u)
             })
             .collect();
-        let mut y = transform.y(&x0);
-        let mut lambda = vec![0.0; m];
-        let mut mu = 10.0;
-        let mut prev_violation = f64::INFINITY;
-        let mut prev_f = f64::INFINITY;
-        for _ in 0..opts.max_outer {
-            let merit = Merit {
-                problem,
-                transform: &transform,
-                lambda: &lambda,
-                mu,
-                cache: RefCell::new((Vec::new(), 0.0, Vec::new())),
-                work: RefCell::new(Evaluation::new(n, m)),
-                evaluations: &counter,
+        let mut al = Lagrangian {
+            problem,
+            transform: &transform,
+            opts,
+            counter: &counter,
+            y: transform.y(&x0),
+            lambda: vec![0.0; m],
+            mu: 10.0,
+            eval: Evaluation::new(n, m),
+            evaluations: 0,
+        };
+        let met_a = al.run(None, opts.max_outer, opts.max_inner);
+        let mut robust_ok = None;
+        let mut robust_violation = None;
+        if let Some(r) = robust
+            && met_a
+        {
+            r.reset();
+            let x = transform.x(&al.y);
+            let v = r.update(&x, None);
+            let first = if v <= opts.feasibility_tol {
+                r.accept(&x)
+            } else {
+                Acceptance::Refined
             };
-            y = lbfgs(merit, y.clone(), opts.max_inner, opts.rel_tol);
-            problem.eval(&transform.x(&y), &mut eval);
-            evaluations += 1;
-            let violation = eval.violation();
-            for (l, g) in lambda.iter_mut().zip(&eval.g) {
-                *l = (*l - mu * g).max(0.0);
+            let mut ok = first == Acceptance::Accepted;
+            if first == Acceptance::Refined && attempts < opts.robust_starts {
+                attempts += 1;
+                // Phase B: the block's constraints join, warm-started from phase A's optimum
+                // with its multipliers; μ restarts low so the new terms are not ill-conditioned.
+                al.mu = 10.0;
+                ok = al.run(Some(r), opts.robust_outer, opts.robust_inner);
             }
-            if violation <= opts.feasibility_tol {
-                if opts.target.is_some_and(|t| eval.f <= t) {
-                    break;
-                }
-                // Converged: feasible, and the last outer step no longer moves f.
-                if (eval.f - prev_f).abs() <= opts.rel_tol * (1.0 + eval.f.abs()) {
-                    break;
-                }
-            } else if violation > 0.25 * prev_violation {
-                mu = (mu * 10.0).min(1e9);
-            }
-            prev_violation = violation;
-            prev_f = eval.f;
+            let x = transform.x(&al.y);
+            robust_violation = Some(r.update(&x, None));
+            robust_ok = Some(ok);
         }
-        let x = transform.x(&y);
-        problem.eval(&x, &mut eval);
+        evaluations += al.evaluations;
+        let x = transform.x(&al.y);
+        problem.eval(&x, &mut al.eval);
         evaluations += 1;
+        let eval = &al.eval;
         let violation = eval.violation();
         let feasible = violation <= opts.feasibility_tol && eval.f.is_finite();
         let met = feasible && opts.target.is_some_and(|t| eval.f <= t);
@@ -341,33 +527,44 @@ pub fn minimize<P: Problem>(problem: &P, opts: &Options) -> Solution {
             violation,
             feasible,
             met_target: met,
+            robust: robust.map(|_| met && robust_ok == Some(true)),
+            robust_violation,
+            robust_attempts: 0,
             start,
             starts_run: start + 1,
             evaluations,
         };
+        let rank = |s: &Solution| (s.robust == Some(true), s.met_target, s.feasible);
         let better = match &best {
             None => true,
-            Some(b) => match (candidate.feasible, b.feasible) {
-                (true, false) => true,
-                (false, true) => false,
-                (true, true) => candidate.f < b.f,
-                (false, false) => candidate.violation < b.violation,
+            Some(b) => match rank(&candidate).cmp(&rank(b)) {
+                std::cmp::Ordering::Greater => true,
+                std::cmp::Ordering::Less => false,
+                std::cmp::Ordering::Equal => {
+                    if candidate.feasible {
+                        candidate.f < b.f
+                    } else {
+                        candidate.violation < b.violation
+                    }
+                }
             },
         };
         if better {
             best = Some(candidate);
         }
-        if met {
+        let done = match robust {
+            None => met,
+            Some(_) => met && robust_ok == Some(true),
+        };
+        if done {
             break;
         }
     }
     let mut best = best.expect("at least one start");
-    best.starts_run = if best.met_target {
-        best.start + 1
-    } else {
-        points.len()
-    };
+    let done = best.met_target && best.robust != Some(false);
+    best.starts_run = if done { best.start + 1 } else { points.len() };
     best.evaluations = evaluations + counter.get();
+    best.robust_attempts = attempts;
     best
 }
 

@@ -24,9 +24,9 @@ mod run;
 
 pub use plan::Plan;
 pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
-pub use record::{AlternativeRecord, Summary, Tally, Timings, level_distribution};
+pub use record::{AlternativeRecord, RankEntry, Summary, Tally, Timings, level_distribution};
 pub use run::{
     Alternative, Evaluation, FailedModel, SHARD_REPORT, SHARD_TASK, SearchError, SearchOptions,
-    ShardReport, Share, check_search, evaluate_units, finish, open_output, plan, prepare, run,
-    run_shard, settings, tally_records,
+    ShardReport, Share, check_search, evaluate_units, finish, model_meta, open_output, plan,
+    prepare, remeasure, run, run_shard, settings, tally_records,
 };

@@ -51,6 +51,11 @@ pub struct RunSettings {
     pub sweep: usize,
     /// foldsynth's version.
     pub foldsynth: String,
+    /// Grammar rules when not the default `r1,r2` (e.g. `r1,r2,r2p`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rules: Option<String>,
+    /// Optimized without the clearance and margin constraints (`--post-check-only`).
+    pub post_check_only: bool,
     /// The share of the search this directory holds (`synthesize --shard K/N`); absent
     /// for a whole run (and for `merge`'s result, which is one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -418,14 +423,13 @@ impl OutputDir {
 
     /// Keep the entries of an earlier manifest that stay (`keep`) in this run's manifest.
     fn adopt(&self, old: &Manifest, keep: &[&str]) -> Result<(), OutputError> {
-        if let Ok(mut m) = self.manifest.lock() {
-            for f in keep {
-                if old.files.contains(*f) {
-                    m.files.insert((*f).to_string());
-                }
+        let mut m = self.manifest.lock().unwrap_or_else(|e| e.into_inner());
+        for f in keep {
+            if old.files.contains(*f) {
+                m.files.insert((*f).to_string());
             }
         }
-        self.save()
+        Self::write_manifest(&self.root, &m)
     }
 
     /// Delete the files an earlier manifest lists (except `keep`), then its directories
@@ -475,17 +479,17 @@ impl OutputDir {
     }
 
     /// Write the manifest (atomically: a temporary file renamed over it). The lock is held
-    /// until the rename: workers listing files at the same time must not share the
-    /// temporary file.
+    /// throughout, so workers listing files at once do not race on the temporary file.
     fn save(&self) -> Result<(), OutputError> {
-        let m = self.manifest.lock().map_err(|_| OutputError::Refused {
-            path: self.root.display().to_string(),
-            message: "the manifest lock is poisoned (a worker panicked)".into(),
-        })?;
-        let tmp = self.root.join(format!("{MANIFEST}.tmp"));
-        let text = serde_json::to_string_pretty(&*m).unwrap_or_default();
+        let m = self.manifest.lock().unwrap_or_else(|e| e.into_inner());
+        Self::write_manifest(&self.root, &m)
+    }
+
+    fn write_manifest(root: &Path, m: &Manifest) -> Result<(), OutputError> {
+        let tmp = root.join(format!("{MANIFEST}.tmp"));
+        let text = serde_json::to_string_pretty(m).unwrap_or_default();
         fs::write(&tmp, text + "\n").map_err(io_err(&tmp))?;
-        let path = self.root.join(MANIFEST);
+        let path = root.join(MANIFEST);
         fs::rename(&tmp, &path).map_err(io_err(&path))
     }
 
@@ -505,19 +509,18 @@ impl OutputDir {
         &self,
         paths: impl IntoIterator<Item = P>,
     ) -> Result<(), OutputError> {
-        if let Ok(mut m) = self.manifest.lock() {
-            for p in paths {
-                let p = p.as_ref();
-                let rel = p.strip_prefix(&self.root).unwrap_or(p);
-                let rel = rel
-                    .components()
-                    .map(|c| c.as_os_str().to_string_lossy())
-                    .collect::<Vec<_>>()
-                    .join("/");
-                m.files.insert(rel);
-            }
+        let mut m = self.manifest.lock().unwrap_or_else(|e| e.into_inner());
+        for p in paths {
+            let p = p.as_ref();
+            let rel = p.strip_prefix(&self.root).unwrap_or(p);
+            let rel = rel
+                .components()
+                .map(|c| c.as_os_str().to_string_lossy())
+                .collect::<Vec<_>>()
+                .join("/");
+            m.files.insert(rel);
         }
-        self.save()
+        Self::write_manifest(&self.root, &m)
     }
 
     /// Create the directory `rel` (listed in the manifest when this run creates it).
@@ -543,10 +546,9 @@ impl OutputDir {
             }
         }
         if !new.is_empty() {
-            if let Ok(mut m) = self.manifest.lock() {
-                m.dirs.extend(new.iter().map(|r| r.to_string()));
-            }
-            self.save()?;
+            let mut m = self.manifest.lock().unwrap_or_else(|e| e.into_inner());
+            m.dirs.extend(new.iter().map(|r| r.to_string()));
+            Self::write_manifest(&self.root, &m)?;
         }
         let mut out = Vec::with_capacity(rels.len());
         for rel in rels {
@@ -712,11 +714,66 @@ pub fn keep_records(
     Ok((open_append(&path)?, Some(report)))
 }
 
-/// FNV-1a (64 bits) of `bytes`, as 16 hex digits: a digest to notice an edited task file.
-pub fn digest(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in bytes {
-        h = (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
+/// Read the records of an earlier run of the same settings. `wanted` says which keys
+/// this search has. Every line that is not reused is reported: a torn last line (the run
+/// was killed while writing it), a line that is not a record, a key this search does not
+/// have, a repeated key.
+pub fn read_records(
+    path: &Path,
+    wanted: &dyn Fn(&str) -> bool,
+) -> Result<(Vec<AlternativeRecord>, ResumeReport), OutputError> {
+    match File::open(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            Ok((Vec::new(), ResumeReport::default()))
+        }
+        Err(e) => Err(io_err(path)(e)),
+        Ok(file) => parse_records(BufReader::new(file), wanted).map_err(io_err(path)),
     }
-    format!("{h:016x}")
+}
+
+/// [`read_records`] on any reader.
+pub fn parse_records(
+    mut reader: impl BufRead,
+    wanted: &dyn Fn(&str) -> bool,
+) -> std::io::Result<(Vec<AlternativeRecord>, ResumeReport)> {
+    let mut report = ResumeReport::default();
+    let mut buf = Vec::new();
+    let mut seen: HashSet<String> = HashSet::new();
+    let mut out = Vec::new();
+    let mut line = 0;
+    loop {
+        buf.clear();
+        if reader.read_until(b'\n', &mut buf)? == 0 {
+            break;
+        }
+        line += 1;
+        let why = if !buf.ends_with(b"\n") {
+            // Only the last line can lack its newline: a kill tore it, whatever it holds.
+            Some("torn (no newline at the end: the run was killed while writing it)".into())
+        } else {
+            match std::str::from_utf8(&buf) {
+                Err(_) => Some("not UTF-8 text".to_string()),
+                Ok(t) if t.trim().is_empty() => continue,
+                Ok(t) => match serde_json::from_str::<AlternativeRecord>(t) {
+                    Err(e) => Some(format!("not a record ({})", excerpt(&e.to_string()))),
+                    Ok(r) if !wanted(&r.key) => Some(format!(
+                        "alternative {} is not part of this search",
+                        excerpt(&r.key)
+                    )),
+                    Ok(r) if !seen.insert(r.key.clone()) => {
+                        Some(format!("alternative {} appears again", excerpt(&r.key)))
+                    }
+                    Ok(r) => {
+                        out.push(r);
+                        None
+                    }
+                },
+            }
+        };
+        if let Some(why) = why {
+            report.drop_line(Dropped { line, why });
+        }
+    }
+    report.reused = out.len();
+    Ok((out, report))
 }

@@ -1,5 +1,6 @@
 //! What the search writes: one record per alternative, and the summary.
 
+use crate::check::robustness::RobustnessReport;
 use crate::check::verify::VerifyReport;
 use crate::check::{Intersection, ObstacleHit};
 use serde::{Deserialize, Serialize};
@@ -50,16 +51,31 @@ pub struct AlternativeRecord {
     /// Whether verification found a bug (isometry, closure, developability or fold angles
     /// off on a rigid state).
     pub verification_failed: Option<bool>,
+    /// Whether the optimizer's robustness block accepted the result (absent with
+    /// `--post-check-only`).
+    #[serde(default)]
+    pub robust_accepted: Option<bool>,
+    /// Starts on which the optimizer ran its robustness phase.
+    #[serde(default)]
+    pub robust_attempts: usize,
+    /// Margins measured independently on the verification sweep (`check::robustness`),
+    /// for alternatives that meet the target.
+    #[serde(default)]
+    pub robustness: Option<RobustnessReport>,
     /// Free variables at the optimum by name.
     pub variables: BTreeMap<String, f64>,
     /// Starting points run.
     pub starts_run: usize,
     /// Model evaluations spent.
     pub evaluations: usize,
-    /// Milliseconds optimizing.
+    /// Milliseconds optimizing (CPU time of the worker thread).
     pub optimize_ms: f64,
-    /// Milliseconds checking and verifying.
+    /// Milliseconds checking and verifying (CPU time of the worker thread).
     pub check_ms: f64,
+    /// For designs of cyclic graphs (r2′) that meet the target: the dense compatibility
+    /// sweep and the bar-and-hinge simulation, which decide whether the design folds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cycle: Option<crate::simulate::crossval::CyclicVerdict>,
 }
 
 impl AlternativeRecord {
@@ -80,6 +96,19 @@ impl AlternativeRecord {
                 .as_ref()
                 .is_some_and(|v| v.rigid_over_motion)
             && self.verification_failed == Some(false)
+            && self.cycle.as_ref().is_none_or(|c| c.passes)
+    }
+
+    /// Whether the design comes from a cyclic graph (an r2′ step in its sequence).
+    pub fn is_cyclic(&self) -> bool {
+        self.sequence.contains(")'")
+    }
+
+    /// The robustness score (−∞ when not measured), for ranking.
+    pub fn score(&self) -> f64 {
+        self.robustness
+            .as_ref()
+            .map_or(f64::NEG_INFINITY, |r| r.score)
     }
 
     /// A file-name-safe identifier.
@@ -93,8 +122,9 @@ impl AlternativeRecord {
     }
 }
 
-/// Seconds spent per stage. Compile, optimize and check add up the time of every worker
-/// (CPU seconds); enumerate, export and total are wall time.
+/// Seconds spent per stage. Compile, optimize and check add up the CPU time of the worker
+/// threads that did them (thread CPU clock: waiting for a core does not count);
+/// enumerate, export and total are wall time; `cpu_s` is the whole process's CPU time.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Timings {
     /// Generating and filtering the graphs.
@@ -109,6 +139,9 @@ pub struct Timings {
     pub export_s: f64,
     /// The whole run, wall clock.
     pub total_s: f64,
+    /// CPU seconds of the whole run, every thread (user + system).
+    #[serde(default)]
+    pub cpu_s: f64,
 }
 
 /// Counts per number of rule applications (thesis Fig. 51).
@@ -159,6 +192,12 @@ pub struct Tally {
     pub optimize_ms: f64,
     /// Milliseconds checking, summed.
     pub check_ms: f64,
+    /// Feasible designs that meet every robustness margin the task sets.
+    pub meets_margins: usize,
+    /// Feasible designs within 1e-3 of the rigidity limit.
+    pub near_rigid_limit: usize,
+    /// The records from cyclic graphs (r2′); `graphs` is left 0.
+    pub cyclic: CyclicCounts,
 }
 
 impl Tally {
@@ -179,6 +218,12 @@ impl Tally {
         self.verification_failures += usize::from(r.verification_failed == Some(true));
         self.optimize_ms += r.optimize_ms;
         self.check_ms += r.check_ms;
+        if r.feasible_design() {
+            let rob = r.robustness.as_ref();
+            self.meets_margins += usize::from(rob.is_some_and(|x| x.meets_settings()));
+            self.near_rigid_limit += usize::from(rob.is_some_and(|x| x.rigid_margin.value < 1e-3));
+        }
+        self.cyclic.add(r);
         while self.levels.len() < r.level {
             self.levels.push(LevelCounts {
                 level: self.levels.len() + 1,
@@ -192,6 +237,15 @@ impl Tally {
             l.no_intersection += usize::from(r.thesis_feasible());
         }
     }
+}
+
+/// One design in the ranking of `summary.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RankEntry {
+    /// The design's id.
+    pub id: String,
+    /// Its robustness score.
+    pub score: Option<f64>,
 }
 
 /// The summary of a search (`OUT/summary.json`).
@@ -218,6 +272,15 @@ pub struct Summary {
     pub rigid_at_tmax_only: usize,
     /// Verification failures (bugs), which must be 0.
     pub verification_failures: usize,
+    /// Feasible designs whose margins, measured on the sweep, meet the task's settings.
+    #[serde(default)]
+    pub meets_margins: usize,
+    /// Feasible designs with a vertex within 1e-3 rad of its rigid limit.
+    #[serde(default)]
+    pub near_rigid_limit: usize,
+    /// The feasible designs, most robust first.
+    #[serde(default)]
+    pub ranking: Vec<RankEntry>,
     /// The thesis's figures for this task, when known (alternatives, meets target, no
     /// self-intersection, no intersection).
     pub thesis: Option<[usize; 4]>,
@@ -229,6 +292,65 @@ pub struct Summary {
     pub settings: serde_json::Value,
     /// Ids of the feasible designs.
     pub designs: Vec<String>,
+    /// With r2′ enabled: what came from cyclic graphs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cyclic: Option<CyclicCounts>,
+}
+
+/// The share of a search that comes from cyclic graphs (r2′).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct CyclicCounts {
+    /// Meaningful cyclic graphs.
+    pub graphs: usize,
+    /// Their alternatives evaluated.
+    pub alternatives: usize,
+    /// … meeting the target at the optimizer's states.
+    pub meets_target: usize,
+    /// … also free of intersections (the thesis's feasibility).
+    pub no_intersection: usize,
+    /// … whose compatibility sweep passes (residual and positions ≤ 1e-9).
+    pub sweep_passes: usize,
+    /// … whose bar-and-hinge simulation agrees (Γ ≤ 1e-8, positions).
+    pub simulation_agrees: usize,
+    /// Feasible designs from cyclic graphs.
+    pub feasible: usize,
+    /// … of those, whose straight crease through the sink folds (the others close the
+    /// cycle trivially: that crease stays flat).
+    pub feasible_folding_shared_crease: usize,
+}
+
+impl CyclicCounts {
+    /// Count the cyclic records among `records`.
+    pub fn count(graphs: usize, records: &[AlternativeRecord]) -> CyclicCounts {
+        let mut c = CyclicCounts {
+            graphs,
+            ..CyclicCounts::default()
+        };
+        for r in records {
+            c.add(r);
+        }
+        c
+    }
+
+    /// Count one record (nothing unless it is cyclic): records are counted as they are
+    /// read, so a streamed search keeps none.
+    pub fn add(&mut self, r: &AlternativeRecord) {
+        if !r.is_cyclic() {
+            return;
+        }
+        let verdict = r.cycle.as_ref();
+        let feasible = r.feasible_design();
+        self.alternatives += 1;
+        self.meets_target += usize::from(r.meets_target);
+        self.no_intersection += usize::from(r.thesis_feasible());
+        self.sweep_passes +=
+            usize::from(verdict.is_some_and(|v| v.sweep.passes(crate::check::cycle::CYCLE_TOL)));
+        self.simulation_agrees +=
+            usize::from(verdict.is_some_and(|v| v.simulation.as_ref().is_some_and(|s| s.agrees)));
+        self.feasible += usize::from(feasible);
+        self.feasible_folding_shared_crease +=
+            usize::from(feasible && verdict.is_some_and(|v| v.sweep.folds_shared_crease()));
+    }
 }
 
 impl Summary {
@@ -283,9 +405,26 @@ impl Summary {
             self.rigid_at_tmax_only
         );
         s += &format!(
+            "  … feasible designs meeting the robustness margins: {} (within 1e-3 rad of a rigid limit: {})\n",
+            self.meets_margins, self.near_rigid_limit
+        );
+        s += &format!(
             "  verification failures (bugs): {}\n",
             self.verification_failures
         );
+        if let Some(c) = &self.cyclic {
+            s += &format!(
+                "  from cyclic graphs (r2′): {} graphs, {} alternatives, {} meet the target, {} also clear, {} pass the compatibility sweep, {} agree with the simulation, {} feasible ({} fold the shared crease)\n",
+                c.graphs,
+                c.alternatives,
+                c.meets_target,
+                c.no_intersection,
+                c.sweep_passes,
+                c.simulation_agrees,
+                c.feasible,
+                c.feasible_folding_shared_crease
+            );
+        }
         s += &format!(
             "time: enumerate {:.2} s, compile {:.2} s, optimize {:.2} s, check {:.2} s (CPU seconds over all workers), export {:.2} s; total {:.2} s wall\n",
             t.enumerate_s, t.compile_s, t.optimize_s, t.check_s, t.export_s, t.total_s

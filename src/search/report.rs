@@ -268,6 +268,10 @@ pub(super) fn report_design(
     files: Option<Files>,
     verify: Option<VerifyReport>,
 ) -> ReportDesign {
+    let mut facts = design_facts(rec, threshold);
+    if let Ok(sc) = crate::export::svg::svg_scale(&pattern, &Default::default()) {
+        facts.push(Fact::new("crease-pattern SVG", sc.note));
+    }
     ReportDesign {
         id: rec.id(),
         level: rec.level,
@@ -275,7 +279,7 @@ pub(super) fn report_design(
         pattern,
         meta,
         robustness: robustness(rec),
-        facts: design_facts(rec, threshold),
+        facts,
         design_file: Some(design_file),
         files,
         verify,

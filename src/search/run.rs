@@ -3,18 +3,21 @@
 use super::output::{self, OutputDir, RECORDS, RunSettings, SETTINGS, ShardSpec};
 use super::plan::{Done, Plan};
 use super::progress::Progress;
-use super::record::{AlternativeRecord, Summary, Tally, Timings};
+use super::record::{AlternativeRecord, RankEntry, Summary, Tally, Timings};
 use super::report::{report_design, report_input, task_facts};
+use crate::check::robustness::{self, RobustnessInput, UnitCreases};
 use crate::check::verify::{Tolerances, verify};
-use crate::check::{CheckError, Cylinder, MotionSettings, check_frames, two_armed};
+use crate::check::{CheckError, Checker, Cylinder, MotionSettings, check_states, two_armed};
 use crate::compile::Options as CompileOptions;
+use crate::cpu_time::Stopwatch;
 use crate::export::{self, DesignMeta, ExportOptions};
-use crate::grammar::CreaseGraph;
+use crate::grammar::{CreaseGraph, Rules};
 use crate::limits;
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
+use crate::model::robust::{RobustModel, RobustProblem, RobustSpec};
 use crate::model::{Model, ModelError};
-use crate::optimize::{self, minimize};
+use crate::optimize::{self, minimize, minimize_robust};
 use crate::pattern::Pattern;
 use crate::task::Task;
 use rayon::prelude::*;
@@ -55,6 +58,11 @@ pub struct SearchOptions {
     /// Show progress on stderr: a bar on a terminal, a status line every few seconds
     /// otherwise (see [`Progress`]).
     pub progress: bool,
+    /// The grammar's rules (default r1, r2; r2′ adds cyclic patterns).
+    pub rules: Rules,
+    /// Today's behaviour before issue 12: optimize without the robustness block and only
+    /// check afterwards (for side-by-side comparisons).
+    pub post_check_only: bool,
 }
 
 impl Default for SearchOptions {
@@ -70,6 +78,8 @@ impl Default for SearchOptions {
             sweep: 181,
             export: true,
             progress: true,
+            rules: Rules::default(),
+            post_check_only: false,
         }
     }
 }
@@ -160,14 +170,30 @@ pub struct Prepared {
     pub model: Model,
     /// Its native code.
     pub compiled: CompiledModel,
+    /// Its robustness block (absent with `--post-check-only`).
+    pub robust: Option<RobustModel>,
 }
 
-/// Build and compile the model of one graph and candidate.
-pub fn prepare(graph: &CreaseGraph, task: &Task, candidate: usize) -> Result<Prepared, String> {
+/// Build and compile the model of one graph and candidate, with its robustness block
+/// when `robust` is given.
+pub fn prepare(
+    graph: &CreaseGraph,
+    task: &Task,
+    candidate: usize,
+    robust: Option<&RobustSpec>,
+) -> Result<Prepared, String> {
     let model = Model::new(graph, task, candidate).map_err(|e| e.to_string())?;
     let compiled =
         CompiledModel::new(&model, &CompileOptions::default()).map_err(|e| e.to_string())?;
-    Ok(Prepared { model, compiled })
+    let robust = robust
+        .map(|spec| RobustModel::new(&model, spec.clone()))
+        .transpose()
+        .map_err(|e| e.to_string())?;
+    Ok(Prepared {
+        model,
+        compiled,
+        robust,
+    })
 }
 
 /// A 64-bit mix (splitmix64) of the run's seed and an alternative's key: every alternative
@@ -220,18 +246,31 @@ fn evaluate(
     let model = &p.model;
     let modes = alt.mode_signs();
     let key = alt.key();
-    let t0 = Instant::now();
+    let t0 = Stopwatch::start();
     let problem = ModelProblem::new(model, &p.compiled, &modes);
-    let sol = minimize(
+    let optimize_opts = optimize::Options {
+        starts: opts.starts,
+        seed: alternative_seed(opts.seed, &key),
+        target: Some(objective_target(model)),
+        ..Default::default()
+    };
+    let mut sol = match &p.robust {
+        None => minimize(&problem, &optimize_opts),
+        Some(block) => {
+            let rp = RobustProblem::new(model, block, &modes);
+            minimize_robust(&problem, Some(&rp), &optimize_opts)
+        }
+    };
+    // Cyclic patterns: Newton on the compatibility equations, to rounding.
+    crate::model::cycle::polish_solution(
         &problem,
-        &optimize::Options {
-            starts: opts.starts,
-            seed: alternative_seed(opts.seed, &key),
-            target: Some(objective_target(model)),
-            ..Default::default()
-        },
+        model,
+        &modes,
+        &mut sol,
+        optimize_opts.feasibility_tol,
+        optimize_opts.target,
     );
-    let optimize_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let optimize_ms = t0.cpu_ms();
     let full = model.full_vars(&sol.x);
     let omega = model.omega(&full, &modes);
     let meets = sol.feasible && omega <= model.threshold;
@@ -262,46 +301,71 @@ fn evaluate(
         obstacle_hit: None,
         verification: None,
         verification_failed: None,
+        robust_accepted: sol.robust,
+        robust_attempts: sol.robust_attempts,
+        robustness: None,
         variables,
         starts_run: sol.starts_run,
         evaluations: sol.evaluations,
         optimize_ms,
         check_ms: 0.0,
+        cycle: None,
     };
     if !meets {
         return rec;
     }
-    let t1 = Instant::now();
+    let t1 = Stopwatch::start();
     let design = Evaluated::new(&model.plan, full, modes);
-    let states = task.check.as_ref().map(|c| c.states).unwrap_or(16);
-    let arm = design.pattern(&sample_times(model.t_max, states));
+    // The judges run on the dense verification sweep, not only on the states the optimizer
+    // saw, so an intersection between sampled states cannot hide.
+    let arm = design.pattern(&sample_times(model.t_max, opts.sweep));
     let checked = checked_pattern(task, &arm)
         .map_err(CheckFailure::Other)
         .and_then(|pat| {
-            let run = |obstacles| {
-                check_frames(
-                    &pat,
-                    &MotionSettings {
-                        n_states: states,
-                        stop_at_first: true,
-                        obstacles,
-                    },
-                )
-                .map_err(|e| match e {
-                    // A facet that cannot be triangulated is inverted or overlaps itself in the
-                    // flat layout: the paper crosses itself before it folds.
-                    CheckError::Triangulate(t) => CheckFailure::Layout(t.to_string()),
-                    e => CheckFailure::Other(e.to_string()),
+            let checker = Checker::from_pattern(&pat).map_err(|e| match e {
+                // A facet that cannot be triangulated is inverted or overlaps itself in the
+                // flat layout: the paper crosses itself before it folds.
+                CheckError::Triangulate(t) => CheckFailure::Layout(t.to_string()),
+                e => CheckFailure::Other(e.to_string()),
+            })?;
+            let s = check_states(
+                &checker,
+                Some(&pat.vertices),
+                pat.frames.iter().map(|f| (f.t, f.coords.clone())),
+                &MotionSettings {
+                    n_states: opts.sweep,
+                    stop_at_first: true,
+                    obstacles: Vec::new(),
+                },
+            )
+            .map_err(|e| CheckFailure::Other(e.to_string()))?;
+            let cyl = obstacles(task);
+            let hit = pat.frames.iter().find_map(|f| {
+                cyl.iter().enumerate().find_map(|(k, c)| {
+                    checker
+                        .obstacle_hits(&f.coords, c, k, f.t, true)
+                        .first()
+                        .copied()
                 })
-            };
-            Ok((run(Vec::new())?, run(obstacles(task))?))
+            });
+            Ok((s, hit, pat))
         });
     match checked {
-        Ok((s, o)) => {
+        Ok((s, hit, pat)) => {
             rec.self_intersection_free = Some(s.self_intersection_free());
             rec.self_intersection = s.first_intersection().cloned();
-            rec.obstacle_free = Some(o.obstacle_hits.is_empty());
-            rec.obstacle_hit = o.first_obstacle_hit().cloned();
+            rec.obstacle_free = Some(hit.is_none());
+            rec.obstacle_hit = hit;
+            rec.robustness = match measure_robustness(task, model, &arm, &pat) {
+                Ok(r) => Some(r),
+                Err(e) => {
+                    eprintln!(
+                        "warning: {}: the robustness measurement failed: {e}",
+                        rec.key
+                    );
+                    None
+                }
+            };
         }
         Err(CheckFailure::Layout(why)) => {
             rec.self_intersection_free = Some(false);
@@ -314,7 +378,7 @@ fn evaluate(
     let tol = Tolerances::default();
     let report = verify(&design, &sample_times(model.t_max, opts.sweep), &tol);
     let failed = !report.geometry_passes(&tol);
-    if failed {
+    if failed && model.plan.sinks.is_empty() {
         eprintln!(
             "BUG: verification failed for {} (graph {}): {}",
             rec.key,
@@ -322,10 +386,140 @@ fn evaluate(
             report.failures(&tol).join("; ")
         );
     }
-    rec.verification_failed = Some(failed);
+    if !model.plan.sinks.is_empty() {
+        // A cyclic design (r2′): the PTU's frames are only right where the cycle closes, so
+        // the sweep and the simulation decide; a geometric failure is a bug only then.
+        let verdict = crate::simulate::crossval::verify_cyclic(
+            model,
+            &design.vars,
+            &design.modes,
+            opts.sweep,
+            tol.geometry_margin,
+        );
+        let failed = failed && verdict.sweep.passes(crate::check::cycle::CYCLE_TOL);
+        rec.verification_failed = Some(failed);
+        rec.cycle = Some(verdict);
+    } else {
+        rec.verification_failed = Some(failed);
+    }
     rec.verification = Some(report);
-    rec.check_ms = t1.elapsed().as_secs_f64() * 1e3;
+    rec.check_ms = t1.cpu_ms();
     rec
+}
+
+/// The robustness of a design measured by `check::robustness` on the checked pattern
+/// (`pat`: the arm, or both arms) at the sweep's frames.
+fn measure_robustness(
+    task: &Task,
+    model: &Model,
+    arm: &Pattern,
+    pat: &Pattern,
+) -> Result<robustness::RobustnessReport, String> {
+    let plan = &model.plan;
+    let face_names: Vec<String> = plan
+        .polygons
+        .iter()
+        .enumerate()
+        .filter(|(_, (p, _))| p.len() >= 3)
+        .map(|(f, _)| plan.facet_names[f].clone())
+        .collect();
+    let n = arm.vertices.len();
+    let vertex_names = (0..pat.vertices.len())
+        .map(|v| {
+            if v < n {
+                format!("v{}", plan.vertices[v].name)
+            } else {
+                format!("copy #{}", v - n + 1)
+            }
+        })
+        .collect();
+    let units = plan
+        .internal
+        .iter()
+        .map(|&a| {
+            let v = &plan.vertices[a];
+            let m = v.preds;
+            UnitCreases {
+                vertex: a,
+                ends: [0, 1, 2].map(|k| v.rays[m + k].other),
+                label: format!("v{}", v.name),
+            }
+        })
+        .collect();
+    let cylinders = obstacles(task);
+    // The arms of a two-armed gripper meet at a target on the rotation axis: their tips
+    // touch there by design (the copy of the gripping vertex is found by its flat position).
+    let tip = (pat.vertices.len() > n
+        && model
+            .targets
+            .iter()
+            .any(|t| t.point[0].abs() < 1e-9 && t.point[1].abs() < 1e-9))
+    .then(|| {
+        let g = model.gripping;
+        let q = [-arm.vertices[g][0], -arm.vertices[g][1]];
+        (n..pat.vertices.len())
+            .find(|&j| (pat.vertices[j][0] - q[0]).hypot(pat.vertices[j][1] - q[1]) <= 1e-9)
+            .map(|c| (g, c))
+    })
+    .flatten();
+    let input = RobustnessInput {
+        pattern: pat,
+        arm_faces: arm.faces.len(),
+        face_names,
+        vertex_names,
+        cylinders: &cylinders,
+        units,
+        tip,
+        t_max: model.t_max,
+        settings: task.robustness,
+    };
+    robustness::measure(&input).map_err(|e| e.to_string())
+}
+
+/// The model of a record's graph and candidate, and the record's free variables, all
+/// variables and mode signs.
+type Design = (Model, Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// Rebuild a recorded design ([`Design`]).
+fn design_of(
+    task: &Task,
+    graph: &CreaseGraph,
+    rec: &AlternativeRecord,
+) -> Result<Design, SearchError> {
+    let model = Model::new(graph, task, rec.candidate - 1)?;
+    let free: Vec<f64> = model
+        .free
+        .iter()
+        .map(|&i| {
+            rec.variables
+                .get(&model.plan.variables[i].name)
+                .copied()
+                .unwrap_or(model.var_bounds(i).0)
+        })
+        .collect();
+    let full = model.full_vars(&free);
+    let modes: Vec<f64> = rec
+        .modes
+        .iter()
+        .map(|m| if m == "up" { 1.0 } else { -1.0 })
+        .collect();
+    Ok((model, free, full, modes))
+}
+
+/// The robustness of a recorded design measured again by `check::robustness` on a sweep of
+/// `states` states (e.g. denser than the search's): `graph` is the record's graph (the
+/// enumeration's meaningful graphs, in order, indexed by `rec.graph`).
+pub fn remeasure(
+    task: &Task,
+    graph: &CreaseGraph,
+    rec: &AlternativeRecord,
+    states: usize,
+) -> Result<robustness::RobustnessReport, String> {
+    let (model, _, full, modes) = design_of(task, graph, rec).map_err(|e| e.to_string())?;
+    let design = Evaluated::new(&model.plan, full, modes);
+    let arm = design.pattern(&sample_times(model.t_max, states.max(2)));
+    let pat = checked_pattern(task, &arm)?;
+    measure_robustness(task, &model, &arm, &pat)
 }
 
 /// Which part of the search a run evaluates: a shard's units (see `distribute`).
@@ -427,8 +621,8 @@ pub fn check_search(task: &Task, opts: &SearchOptions) -> Result<usize, SearchEr
 }
 
 /// The plan of `task`'s search at `n_max`; an error when there is nothing to search.
-pub fn plan(task: &Task, n_max: usize) -> Result<Plan, SearchError> {
-    let plan = Plan::new(task, n_max);
+pub fn plan(task: &Task, n_max: usize, rules: Rules) -> Result<Plan, SearchError> {
+    let plan = Plan::with_rules(task, n_max, rules);
     if plan.graphs.is_empty() {
         return Err(SearchError::Task {
             task: task.name.clone(),
@@ -455,6 +649,8 @@ pub fn settings(
         seed: opts.seed,
         sweep: opts.sweep,
         foldsynth: env!("CARGO_PKG_VERSION").into(),
+        rules: (opts.rules != Rules::default()).then(|| opts.rules.names()),
+        post_check_only: opts.post_check_only,
         shard,
     }
 }
@@ -482,7 +678,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     let n_max = check_search(task, opts)?;
     let progress = Progress::new(opts.progress);
     progress.phase("enumerate graphs", "graphs", None);
-    let plan = plan(task, n_max)?;
+    let plan = plan(task, n_max, opts.rules)?;
     progress.inc(plan.graphs.len() as u64);
     progress.finish_phase_with(&format!(
         "{} generated, {} meaningful",
@@ -526,6 +722,7 @@ pub fn run_shard(
             check_s: tally.check_ms / 1e3 + 0.0,
             export_s: 0.0,
             total_s: start.elapsed().as_secs_f64(),
+            cpu_s: crate::cpu_time::process_seconds(),
         },
     };
     out.write(
@@ -594,6 +791,7 @@ pub fn evaluate_units(
     let write_error: Mutex<Option<std::io::Error>> = Mutex::new(None);
     let compile_s = Mutex::new(0.0f64);
     let failed: Mutex<Vec<FailedModel>> = Mutex::new(Vec::new());
+    let robust_spec = (!opts.post_check_only).then(|| RobustSpec::from_task(task, opts.sweep));
     progress.phase(
         "compile + optimize + check",
         "alternatives",
@@ -612,9 +810,9 @@ pub fn evaluate_units(
             let unit = &plan.units[u];
             let modes: Vec<u32> = undone(u).collect();
             let graph = plan.graph(task, unit.graph);
-            let t = Instant::now();
-            let prepared = prepare(&graph, task, unit.candidate);
-            *compile_s.lock().unwrap_or_else(|e| e.into_inner()) += t.elapsed().as_secs_f64();
+            let t = Stopwatch::start();
+            let prepared = prepare(&graph, task, unit.candidate, robust_spec.as_ref());
+            *compile_s.lock().unwrap_or_else(|e| e.into_inner()) += t.cpu_ms() / 1e3;
             let prepared = match prepared {
                 Ok(p) => p,
                 Err(error) => {
@@ -673,8 +871,8 @@ pub fn evaluate_units(
 }
 
 /// Read a records file line by line: the summary's counts, and where each feasible
-/// design's record is (its alternative number and the byte offset of its line), in
-/// record order.
+/// design's record is (its alternative number and the byte offset of its line), most
+/// robust first (ties: enumeration order).
 pub fn tally_records(plan: &Plan, path: &Path) -> Result<(Tally, Vec<(u64, u64)>), SearchError> {
     let io = |source| SearchError::Io {
         path: path.display().to_string(),
@@ -705,12 +903,13 @@ pub fn tally_records(plan: &Plan, path: &Path) -> Result<(Tally, Vec<(u64, u64)>
             let place = plan
                 .locate(&rec.key)
                 .ok_or_else(|| bad(format!("{} is not an alternative of this search", rec.key)))?;
-            designs.push((place.index, offset));
+            designs.push((rec.score(), place.index, offset));
         }
         offset += n as u64;
     }
-    designs.sort_unstable();
-    Ok((tally, designs))
+    // Most robust first (ties: enumeration order).
+    designs.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    Ok((tally, designs.into_iter().map(|(_, i, o)| (i, o)).collect()))
 }
 
 /// Summarize the records in `OUT/alternatives.jsonl` and write `summary.json`, the
@@ -733,6 +932,7 @@ pub fn finish(
         check_s: tally.check_ms / 1e3 + 0.0,
         export_s: 0.0,
         total_s: 0.0,
+        cpu_s: 0.0,
     };
     let mut ids = Vec::with_capacity(designs.len());
     let mut summary = Summary {
@@ -756,16 +956,38 @@ pub fn finish(
         settings: json!({
             "starts": opts.starts, "seed": opts.seed, "jobs": ev.jobs,
             "sweep": opts.sweep, "resumed": ev.resumed, "resume": ev.resume,
+            "post_check_only": opts.post_check_only,
+            "optimize_states": (!opts.post_check_only)
+                .then(|| RobustSpec::from_task(task, opts.sweep).states),
+            "robustness": {
+                "rigid_margin": task.robustness.rigid_margin,
+                "clearance": task.robustness.clearance,
+                "obstacle_clearance": task.robustness.obstacle_clearance,
+            },
         }),
+        meets_margins: tally.meets_margins,
+        near_rigid_limit: tally.near_rigid_limit,
+        ranking: Vec::new(),
         designs: Vec::new(),
+        cyclic: opts.rules.r2p.then(|| {
+            let mut c = tally.cyclic.clone();
+            c.graphs = plan.cyclic_graphs;
+            c
+        }),
     };
-    // The ids, in record order, from the records themselves.
+    // The ids and scores, most robust first (the order of `designs`), from the records.
+    let mut ranking = Vec::with_capacity(designs.len());
     for chunk in designs.chunks(1024) {
         for rec in read_at(&records, chunk)? {
             ids.push(rec.id());
+            ranking.push(RankEntry {
+                id: rec.id(),
+                score: rec.robustness.as_ref().map(|x| x.score),
+            });
         }
     }
     summary.designs = ids;
+    summary.ranking = ranking;
 
     let t2 = Instant::now();
     summary.timings.total_s = start.elapsed().as_secs_f64();
@@ -774,6 +996,8 @@ pub fn finish(
     )?;
     timings.export_s = t2.elapsed().as_secs_f64();
     timings.total_s = start.elapsed().as_secs_f64();
+    // A run (or a merge) is one process: its CPU time so far.
+    timings.cpu_s = crate::cpu_time::process_seconds();
     summary.timings = timings;
     out.write(
         "summary.json",
@@ -807,15 +1031,21 @@ fn read_at(path: &Path, places: &[(u64, u64)]) -> Result<Vec<AlternativeRecord>,
 
 /// The export metadata of a design.
 fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMeta {
+    let mut meta = model_meta(task, model, &rec.modes, rec.objective);
+    meta.extra
+        .insert("candidate".to_string(), json!(rec.candidate));
+    meta.extra.insert("key".to_string(), json!(rec.key));
+    meta
+}
+
+/// The export metadata of a design of `model` with `modes` ("up"/"down") and objective
+/// Ω* (also for designs outside a search, e.g. `foldsynth model --save`).
+pub fn model_meta(task: &Task, model: &Model, modes: &[String], objective: f64) -> DesignMeta {
     let multi = model.targets.len() > 1;
-    let mut extra = BTreeMap::new();
-    extra.insert("candidate".to_string(), json!(rec.candidate));
-    extra.insert("key".to_string(), json!(rec.key));
     DesignMeta {
         task: task.name.clone(),
-        rule_sequence: rec.sequence.clone(),
-        modes: rec
-            .modes
+        rule_sequence: model.plan.sequence.clone(),
+        modes: modes
             .iter()
             .map(|m| {
                 if m == "up" {
@@ -827,7 +1057,7 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
             .collect(),
         // The vertex name (1-based), as in the rule sequence and the record.
         gripping_vertex: Some(model.plan.vertices[model.gripping].name),
-        objective: Some(rec.objective),
+        objective: Some(objective),
         targets: model
             .targets
             .iter()
@@ -846,12 +1076,13 @@ fn design_meta(task: &Task, model: &Model, rec: &AlternativeRecord) -> DesignMet
             .as_ref()
             .and_then(|c| c.cylinders.first().copied()),
         second_arm: task.check.as_ref().is_some_and(|c| c.second_arm),
-        extra,
+        extra: BTreeMap::new(),
     }
 }
 
 /// Write `designs/<id>.json` for every feasible design, with export its files, and the
 /// report (always: its 3D views need only the geometry).
+// The run's parts, each borrowed once; a struct of them would only rename the call.
 #[allow(clippy::too_many_arguments)]
 fn write_designs(
     task: &Task,

@@ -577,7 +577,9 @@ impl CrossvalReport {
     /// error bound.
     pub fn agrees(&self, gamma_tol: f64, position_tol: f64) -> bool {
         self.gamma <= gamma_tol
-            && self.final_position_error.is_some()
+            && self.max_position_error.is_finite()
+            && self.drive_error.is_finite()
+            && self.final_position_error.is_some_and(f64::is_finite)
             && self
                 .states
                 .iter()
@@ -668,22 +670,16 @@ fn compare(
             sim.steps[j - 1].t
         };
         let frame = frame_at(t);
-        let err = frame.map(|f| {
-            x.iter()
-                .zip(&f.coords)
-                .map(|(a, b)| geom::dist(*a, *b))
-                .fold(0.0, f64::max)
-        });
+        // NaN-propagating maxima: a NaN position must fail the comparison, not vanish.
+        let err = frame
+            .map(|f| geom::max_or_nan(x.iter().zip(&f.coords).map(|(a, b)| geom::dist(*a, *b))));
         if let Some(f) = frame {
-            let d = prescribed
-                .iter()
-                .map(|&v| geom::dist(x[v], f.coords[v]))
-                .fold(0.0, f64::max);
+            let d = geom::max_or_nan(prescribed.iter().map(|&v| geom::dist(x[v], f.coords[v])));
             if j == 0 {
                 start_gap = err;
             } else {
-                drive_err = drive_err.max(d);
-                max_err = max_err.max(err.unwrap_or(0.0));
+                drive_err = geom::max_or_nan([drive_err, d]);
+                max_err = geom::max_or_nan([max_err, err.unwrap_or(0.0)]);
                 compared += 1;
             }
         }
@@ -795,4 +791,82 @@ pub fn design_drive(model: &Model) -> Result<G0Drive, CrossvalError> {
         source: expr.to_string(),
         angle: Arc::new(move |t| expr.eval(&t)),
     })
+}
+
+/// Steps of the bar-and-hinge simulation that judges a cyclic design (the thesis's 30).
+pub const CYCLIC_STEPS: usize = 30;
+
+/// The bar-and-hinge side of a cyclic design's verdict.
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
+pub struct SimulationVerdict {
+    /// Steps J.
+    pub steps: usize,
+    /// Rigidity error Γ (Eq. 4).
+    pub gamma: f64,
+    /// Largest δ(j).
+    pub max_delta: f64,
+    /// Largest distance between a simulated vertex and the PTU's.
+    pub max_position_error: f64,
+    /// Γ ≤ [`GAMMA_TOL`] and every state within the position tolerance.
+    pub agrees: bool,
+}
+
+/// Both verifications of a cyclic design (r2′): the dense PTU sweep
+/// ([`crate::check::cycle`]) and the bar-and-hinge simulation driven by G0's crease, which
+/// decides.
+#[derive(Clone, Debug, Serialize, serde::Deserialize)]
+pub struct CyclicVerdict {
+    /// The sweep: compatibility residual and position disagreement.
+    pub sweep: crate::check::cycle::CycleReport,
+    /// The simulation (absent when the sweep already failed, or with `error`).
+    pub simulation: Option<SimulationVerdict>,
+    /// Why the simulation could not run.
+    pub error: Option<String>,
+    /// The sweep within [`crate::check::cycle::CYCLE_TOL`] and the simulation agreeing.
+    pub passes: bool,
+}
+
+/// Verify a cyclic design of `model` (full variables, ±1 modes): the sweep over
+/// `sweep` states of [0, t_max], then, if it passes, [`CYCLIC_STEPS`] steps of the
+/// bar-and-hinge simulation compared with the PTU ([`crossval_design`]).
+pub fn verify_cyclic(
+    model: &Model,
+    full_vars: &[f64],
+    modes: &[f64],
+    sweep: usize,
+    geometry_margin: f64,
+) -> CyclicVerdict {
+    use crate::check::cycle::{CYCLE_TOL, verify_cycles};
+    let design = Evaluated::new(&model.plan, full_vars.to_vec(), modes.to_vec());
+    let report = verify_cycles(&design, &sample_times(model.t_max, sweep), geometry_margin);
+    let mut v = CyclicVerdict {
+        passes: false,
+        simulation: None,
+        error: None,
+        sweep: report,
+    };
+    if !v.sweep.passes(CYCLE_TOL) {
+        return v;
+    }
+    match crossval_design(
+        model,
+        full_vars.to_vec(),
+        modes.to_vec(),
+        CYCLIC_STEPS,
+        &CrossvalOptions::default(),
+    ) {
+        Ok(r) => {
+            let agrees = r.agrees(GAMMA_TOL, POSITION_TOL);
+            v.simulation = Some(SimulationVerdict {
+                steps: r.steps,
+                gamma: r.gamma,
+                max_delta: r.max_delta,
+                max_position_error: r.max_position_error,
+                agrees,
+            });
+            v.passes = agrees;
+        }
+        Err(e) => v.error = Some(e.to_string()),
+    }
+    v
 }

@@ -40,14 +40,15 @@ pub struct FormulaError {
 
 impl fmt::Display for FormulaError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (shown, at) = crate::text::window(&self.source, self.position, 80);
         write!(
             f,
             "{} at character {} of \"{}\"\n    {}\n    {}^",
             self.message,
             self.position + 1,
-            self.source,
-            self.source,
-            " ".repeat(self.position)
+            crate::text::excerpt(&self.source, 80),
+            shown,
+            " ".repeat(at)
         )
     }
 }
@@ -119,6 +120,13 @@ pub struct Formula {
 impl Formula {
     /// Parse `source`.
     pub fn parse(source: &str) -> Result<Formula, FormulaError> {
+        if let Err((position, message)) = crate::limits::check_expression(source) {
+            return Err(FormulaError {
+                source: source.to_string(),
+                position,
+                message,
+            });
+        }
         let chars: Vec<char> = source.chars().collect();
         let mut p = Parser {
             src: source,

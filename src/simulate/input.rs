@@ -141,6 +141,10 @@ pub struct SolverSettings {
     /// ends just short of its limit (Eq. 33 keeps only 1e-8) needs many more to follow
     /// its branch; the cross-validation allows 18.
     pub max_refine: usize,
+    /// Most solver iterations one reported step may spend on refinement (default
+    /// [`super::run::REFINE_ITERATION_BUDGET`]); where it stops, the step is taken as it
+    /// stands and reported as capped.
+    pub refine_budget: usize,
 }
 
 impl Default for SolverSettings {
@@ -152,6 +156,7 @@ impl Default for SolverSettings {
             residual_tolerance: 1e-15,
             max_correction: f64::INFINITY,
             max_refine: 6,
+            refine_budget: super::run::REFINE_ITERATION_BUDGET,
         }
     }
 }

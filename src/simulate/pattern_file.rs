@@ -173,7 +173,7 @@ impl PatternFile {
     /// Read and parse a pattern file.
     pub fn load(path: &Path) -> Result<PatternFile, PatternFileError> {
         let origin = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| PatternFileError {
+        let text = crate::limits::read_text(path).map_err(|e| PatternFileError {
             origin: origin.clone(),
             field: "file".into(),
             message: format!("cannot read: {e}"),
@@ -188,8 +188,17 @@ impl PatternFile {
             field: field.to_string(),
             message,
         };
-        let spec: Spec = toml::from_str(text)
-            .map_err(|e| err("toml", e.to_string().trim_end().replace('\n', "\n    ")))?;
+        if let Some(kind) = crate::text::other_kind(text, "pattern") {
+            return Err(err("(file)", kind));
+        }
+        let spec: Spec = toml::from_str(text).map_err(|e| {
+            err(
+                "toml",
+                crate::text::excerpt(&e.to_string(), 600)
+                    .trim_end()
+                    .replace('\n', "\n    "),
+            )
+        })?;
         let rot = match &spec.symmetry {
             None => 1,
             Some(s) if (1..=360).contains(&s.rotations) => s.rotations,
@@ -220,7 +229,7 @@ impl PatternFile {
                     &format!("{field}.name"),
                     format!(
                         "'{}' is not allowed: names are non-empty, without '@' or spaces",
-                        v.name
+                        crate::text::excerpt(&v.name, 40)
                     ),
                 ));
             }
@@ -240,10 +249,15 @@ impl PatternFile {
                     ));
                 }
             };
-            if p.iter().any(|x| !x.is_finite()) {
+            if p.iter()
+                .any(|x| !(x.is_finite() && x.abs() <= crate::limits::COORD_MAX))
+            {
                 return Err(err(
                     &format!("{field}.at"),
-                    "coordinates must be finite".into(),
+                    format!(
+                        "coordinates must be finite and within ±{}",
+                        crate::text::num(crate::limits::COORD_MAX)
+                    ),
                 ));
             }
             let on_axis = rot > 1 && p[0].abs() <= 1e-12 && p[1].abs() <= 1e-12;
@@ -352,8 +366,15 @@ impl PatternFile {
         };
         let t_start = constant("motion.t_start", &spec.motion.t_start)?;
         let t_end = constant("motion.t_end", &spec.motion.t_end)?;
-        if spec.motion.steps == 0 {
-            return Err(err("motion.steps", "must be at least 1".into()));
+        let max = crate::limits::STEPS_MAX;
+        if spec.motion.steps == 0 || spec.motion.steps as u64 > max {
+            return Err(err(
+                "motion.steps",
+                format!(
+                    "{} is not allowed: must be at least 1 and at most {max}",
+                    spec.motion.steps
+                ),
+            ));
         }
         let formula = |field: &str, n: &Num| -> Result<Formula, PatternFileError> {
             match n {

@@ -45,6 +45,10 @@ pub struct StepReport {
     pub iterations: usize,
     /// Substeps the step was finally taken in (1 unless a branch jump forced refinement).
     pub substeps: usize,
+    /// Whether refinement stopped at its budget ([`REFINE_ITERATION_BUDGET`] by default) before the half steps
+    /// agreed: a motion no small step can follow (e.g. a prescribed vertex that jumps).
+    #[serde(default)]
+    pub refinement_capped: bool,
     /// The first self-intersection found at this step, if any (with the check on).
     pub intersection: Option<Intersection>,
 }
@@ -86,6 +90,15 @@ impl SimReport {
 /// step and in two half steps before the step is refined.
 pub const BRANCH_TOLERANCE: f64 = 1e-4;
 
+/// Most solver iterations one reported step may spend on refinement, by default
+/// ([`super::SolverSettings::refine_budget`]). A step that follows
+/// a branch refines along one path; near a flat or singular state that can take a few
+/// hundred thousand (352,111 for the last step of the gripper's g06-c2-uu at N_max = 2,
+/// seed 1), so the budget is several times that. A motion that no step size can follow
+/// would otherwise refine every half down to `max_refine`, 2^18 substeps: hours, found
+/// by fuzzing.
+pub const REFINE_ITERATION_BUDGET: usize = 2_000_000;
+
 /// Takes one reported step by continuation.
 ///
 /// Each step starts from the previous solution (Eq. 3), moved along the motion's tangent
@@ -109,6 +122,8 @@ struct Stepper<'a> {
     hint: Option<(Vec<[f64; 3]>, f64)>,
     /// How far the last solve moved the free vertices from its predicted start.
     last_correction: f64,
+    /// Whether this step's refinement stopped at the budget.
+    capped: bool,
 }
 
 impl Stepper<'_> {
@@ -211,6 +226,11 @@ impl Stepper<'_> {
             self.substeps += 1;
             return Ok(full);
         }
+        if self.iterations >= self.input.solver.refine_budget {
+            self.capped = true;
+            self.substeps += 1;
+            return Ok(full);
+        }
         let tm = 0.5 * (t0 + t1);
         let mid = self.solve_at(tm, x0, t0, before)?;
         let two = self.solve_at(t1, &mid, tm, Some((x0, t0)))?;
@@ -288,6 +308,7 @@ pub fn simulate_with_checker(
         substeps: 0,
         hint: None,
         last_correction: 0.0,
+        capped: false,
     };
     if !input.first_step_offsets.is_empty() {
         let mut dx = vec![[0.0; 3]; n];
@@ -302,6 +323,7 @@ pub fn simulate_with_checker(
         let t = input.t_start + (input.t_end - input.t_start) * j as f64 / jj as f64;
         stepper.iterations = 0;
         stepper.substeps = 0;
+        stepper.capped = false;
         let next = stepper.advance(
             &x,
             t_prev,
@@ -322,6 +344,7 @@ pub fn simulate_with_checker(
             delta_length: bars.delta_length(&x),
             iterations: stepper.iterations,
             substeps: stepper.substeps,
+            refinement_capped: stepper.capped,
             intersection,
         });
         states.push(x.clone());

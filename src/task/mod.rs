@@ -32,6 +32,7 @@
 mod drive;
 mod initial;
 pub mod number;
+mod robustness;
 
 use std::path::{Path, PathBuf};
 
@@ -40,6 +41,7 @@ use serde::Deserialize;
 pub use drive::Drive;
 pub use initial::{InitialCrease, InitialGraph, InitialVertex};
 pub use number::Number;
+pub use robustness::{DEFAULT_CLEARANCE, DEFAULT_RIGID_MARGIN, MAX_RIGID_MARGIN, Robustness};
 
 use crate::grammar::VertexType;
 
@@ -83,6 +85,9 @@ pub struct Task {
     pub objective: Option<Objective>,
     /// Intersection-check setup (Sec. 5.4.2), if given.
     pub check: Option<CheckSpec>,
+    /// Margins the optimizer keeps over the whole motion (`[robustness]`, defaults when
+    /// absent).
+    pub robustness: Robustness,
 }
 
 /// Symmetry of a design task.
@@ -143,7 +148,14 @@ pub struct CheckSpec {
     /// The design is one arm of a two-armed device: checks and pictures include a copy
     /// rotated 180° about the z-axis (the gripper, Sec. 5.5.1).
     pub second_arm: bool,
+    /// Number of evenly spaced states over [0, t_max] at which the optimizer imposes the
+    /// clearance and margin constraints (more are added where a finer sweep finds the
+    /// design closer than allowed).
+    pub optimize_states: usize,
 }
+
+/// Default of `[check] optimize_states`.
+pub const DEFAULT_OPTIMIZE_STATES: usize = 9;
 
 /// A cylinder obstacle (axis segment `a → b` and radius): the checks' own type, so the
 /// task, the intersection check and the pictures share one definition.
@@ -169,6 +181,7 @@ struct RawTask {
     bounds: Option<RawBounds>,
     objective: Option<RawObjective>,
     check: Option<RawCheck>,
+    robustness: Option<robustness::RawRobustness>,
 }
 
 #[derive(Deserialize)]
@@ -267,6 +280,7 @@ struct RawCheck {
     cylinders: Vec<RawCylinder>,
     #[serde(default)]
     second_arm: bool,
+    optimize_states: Option<i64>,
 }
 
 #[derive(Deserialize)]
@@ -364,6 +378,9 @@ impl Task {
     /// Parse and validate task text; `file` labels the messages.
     pub fn from_toml_str(text: &str, file: &str) -> Result<Task, TaskError> {
         let cx = Ctx { file };
+        if let Some(kind) = crate::text::other_kind(text, "task") {
+            return Err(cx.err("(file)", kind));
+        }
         let raw: RawTask = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
         let name = raw.name.clone().unwrap_or_default();
         check_name(&name).map_err(|m| cx.err("name", m))?;
@@ -514,8 +531,17 @@ impl Task {
                     return Err(cx.err(
                         "check.states",
                         format!(
-                            "{} is not allowed: 2 (0 and t_max) to {max} states",
+                            "{} is not allowed: at least 2 states (0 and t_max), at most {max}",
                             c.states
+                        ),
+                    ));
+                }
+                let optimize_states = c.optimize_states.unwrap_or(DEFAULT_OPTIMIZE_STATES as i64);
+                if !(2..=crate::limits::STATES_MAX as i64).contains(&optimize_states) {
+                    return Err(cx.err(
+                        "check.optimize_states",
+                        format!(
+                            "{optimize_states} is not allowed: at least 2 states (0 and t_max), at most {}", crate::limits::STATES_MAX
                         ),
                     ));
                 }
@@ -547,9 +573,12 @@ impl Task {
                     states: c.states as usize,
                     cylinders,
                     second_arm: c.second_arm,
+                    optimize_states: optimize_states as usize,
                 })
             }
         };
+
+        let robustness = robustness::build(&cx, raw.robustness.as_ref(), &initial)?;
 
         Ok(Task {
             name: name.trim().to_string(),
@@ -563,6 +592,7 @@ impl Task {
             bounds,
             objective,
             check,
+            robustness,
         })
     }
 }
@@ -590,7 +620,7 @@ fn check_name(name: &str) -> Result<(), String> {
 }
 
 /// FNV-1a (64 bits) of `bytes`, as 16 hex digits: enough to notice an edited file.
-fn digest(bytes: &[u8]) -> String {
+pub fn digest(bytes: &[u8]) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for b in bytes {
         h = (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
@@ -619,6 +649,6 @@ fn syntax_error(file: &str, text: &str, e: &toml::de::Error) -> TaskError {
     TaskError {
         file: file.to_owned(),
         field,
-        message: format!("{loc}{}", e.message().trim()),
+        message: format!("{loc}{}", crate::text::excerpt(e.message().trim(), 300)),
     }
 }

@@ -88,6 +88,13 @@ pub enum Expr {
 impl Expr {
     /// Parse `s`.
     pub fn parse(s: &str) -> Result<Expr, String> {
+        crate::limits::check_expression(s).map_err(|(at, m)| {
+            format!(
+                "{m} (at character {} of \"{}\")",
+                at + 1,
+                crate::text::excerpt(s, 60)
+            )
+        })?;
         let mut p = Parser { src: s, pos: 0 };
         p.skip_ws();
         if p.pos == s.len() {
@@ -97,9 +104,10 @@ impl Expr {
         p.skip_ws();
         if p.pos != s.len() {
             return Err(format!(
-                "unexpected `{}` at character {} of \"{s}\"",
-                &s[p.pos..],
-                p.pos + 1
+                "unexpected `{}` at character {} of \"{}\"",
+                crate::text::excerpt(&s[p.pos..], 40),
+                p.pos + 1,
+                crate::text::excerpt(s, 60)
             ));
         }
         Ok(e)
@@ -241,7 +249,8 @@ impl Parser<'_> {
                         Ok(Expr::Call(name, Box::new(self.atom()?)))
                     }
                     _ => Err(format!(
-                        "unknown name `{word}` (allowed: numbers, pi, sin, cos, sqrt, + - * / ^, parentheses)"
+                        "unknown name `{}` (allowed: numbers, pi, sin, cos, sqrt, + - * / ^, parentheses)",
+                        crate::text::excerpt(word, 40)
                     )),
                 }
             }

@@ -1,0 +1,731 @@
+//! How robust a folded motion is, measured independently of the optimizer's constraints
+//! (issue 12): the smallest rigid-foldability margin, self clearance, clearance to the
+//! rotated copy and to the obstacles over a dense sweep of states, each with where and
+//! when it occurs.
+//!
+//! Nothing here shares code with the model's clearance constraints (`model::clearance`,
+//! separating planes fitted by Gilbert's algorithm): the facets are triangulated as for
+//! the Möller check and every distance is exact and closed form —
+//! - facets sharing no vertex: the triangle–triangle distance (0 when Möller's test finds
+//!   them crossing, else the least of the six point–triangle and nine segment–segment
+//!   distances);
+//! - facets sharing one vertex: the angle θ between their cones at that vertex (the
+//!   spherical polygons they cut from the unit sphere around it; 0 when those overlap),
+//!   reported as the chord `2 sin(θ/2)`, the gap at unit distance from the vertex; the
+//!   same about the midpoint of the two tips for the facets of a two-armed gripper's tips,
+//!   which meet at the target by design;
+//! - facets sharing a crease: `2 sin((π − |ρ|)/2)` with the fold angle measured from the
+//!   two facets' geometry (the flip test's angle);
+//! - a facet and a cylinder: the triangle–segment distance to the axis minus the radius
+//!   (clearance from the capsule around the axis, which contains the flat-capped cylinder);
+//! - rigid margins: `U_j + U_k − U_i` from the angles between the three creases that bound
+//!   the units of each internal vertex in the folded 3D state (not the PTU's formulas),
+//!   divided by `(t/t_max)²` (the flat state is degenerate; see `task::Robustness`).
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use super::cylinder::Cylinder;
+use super::self_intersection::{CheckError, Checker};
+use super::tri_tri::{Tri, triangles_intersect};
+use crate::pattern::Pattern;
+use crate::task::{DEFAULT_CLEARANCE, DEFAULT_RIGID_MARGIN, Robustness};
+
+type V = Vector3<f64>;
+
+/// One margin of a design: its smallest value over the sweep, the setting it is held to,
+/// where and when.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MarginReport {
+    /// The smallest value found.
+    pub value: f64,
+    /// The task's setting for it.
+    pub setting: f64,
+    /// The state where it occurs.
+    pub t: Option<f64>,
+    /// Which vertex, facet pair or obstacle.
+    #[serde(rename = "where")]
+    pub location: String,
+}
+
+/// The robustness of a design (the `robustness` field of records and design files).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RobustnessReport {
+    /// The smallest of the present margins, each divided by its setting (settings of 0 are
+    /// skipped; when all are 0, each is divided by its default instead).
+    pub score: f64,
+    /// Smallest Eq. 25 margin over the motion (rad, normalized by (t/t_max)²).
+    pub rigid_margin: MarginReport,
+    /// Smallest clearance between facets of the arm (paper units).
+    pub self_clearance: Option<MarginReport>,
+    /// Smallest clearance between the arm and its rotated copy.
+    pub arm_clearance: Option<MarginReport>,
+    /// Smallest clearance between a facet and an obstacle.
+    pub obstacle_clearance: Option<MarginReport>,
+    /// Smallest feature (issue 20; not measured yet).
+    pub min_feature: Option<MarginReport>,
+}
+
+impl RobustnessReport {
+    /// Whether every present margin is at least its setting.
+    pub fn meets_settings(&self) -> bool {
+        self.margins().all(|m| m.value >= m.setting)
+    }
+
+    /// The present margins.
+    pub fn margins(&self) -> impl Iterator<Item = &MarginReport> {
+        std::iter::once(&self.rigid_margin)
+            .chain(self.self_clearance.as_ref())
+            .chain(self.arm_clearance.as_ref())
+            .chain(self.obstacle_clearance.as_ref())
+            .chain(self.min_feature.as_ref())
+    }
+}
+
+/// An internal vertex and the far ends of the three creases that bound its units (the
+/// slots s1, s2, s3 of rule r1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct UnitCreases {
+    /// The vertex (pattern index).
+    pub vertex: usize,
+    /// Far ends of s1, s2, s3.
+    pub ends: [usize; 3],
+    /// Its name for reports ("v4").
+    pub label: String,
+}
+
+/// What the measurement needs besides the pattern.
+#[derive(Clone, Debug)]
+pub struct RobustnessInput<'a> {
+    /// The pattern with frames at the sweep; for two-armed tasks the arm's faces first,
+    /// then their rotated copies (as `check::two_armed` builds it).
+    pub pattern: &'a Pattern,
+    /// Number of the arm's faces (all of them for one-armed tasks).
+    pub arm_faces: usize,
+    /// Names of the arm's faces ("f3"); copies get a prime.
+    pub face_names: Vec<String>,
+    /// Names of the pattern's vertices ("v4"; copies "v4′").
+    pub vertex_names: Vec<String>,
+    /// Obstacles.
+    pub cylinders: &'a [Cylinder],
+    /// The internal vertices.
+    pub units: Vec<UnitCreases>,
+    /// For a two-armed task whose arms meet at the target: the arm's gripping vertex and
+    /// its copy (pattern indices).
+    pub tip: Option<(usize, usize)>,
+    /// End of the motion.
+    pub t_max: f64,
+    /// The settings margins are held to.
+    pub settings: Robustness,
+}
+
+/// How two faces relate.
+#[derive(Clone, Copy, Debug)]
+enum Relation {
+    Apart,
+    Wedge(usize),
+    Tip,
+    Crease(usize),
+}
+
+/// Least value, its t and where.
+#[derive(Clone, Debug)]
+struct Least {
+    value: f64,
+    t: Option<f64>,
+    location: String,
+}
+
+impl Least {
+    fn new() -> Least {
+        Least {
+            value: f64::INFINITY,
+            t: None,
+            location: String::new(),
+        }
+    }
+    fn offer(&mut self, value: f64, t: f64, location: impl FnOnce() -> String) {
+        if value < self.value {
+            self.value = value;
+            self.t = Some(t);
+            self.location = location();
+        }
+    }
+    fn report(self, setting: f64) -> Option<MarginReport> {
+        self.t.map(|_| MarginReport {
+            value: self.value,
+            setting,
+            t: self.t,
+            location: self.location,
+        })
+    }
+}
+
+/// Measure the robustness of the motion in `input.pattern` (see the module docs).
+pub fn measure(input: &RobustnessInput<'_>) -> Result<RobustnessReport, CheckError> {
+    let pat = input.pattern;
+    let checker = Checker::from_pattern(pat)?;
+    let tris = checker.triangles();
+    let nf = pat.faces.len();
+    let face_name = |f: usize| {
+        if f < input.arm_faces {
+            input.face_names.get(f).cloned().unwrap_or(format!("#{f}"))
+        } else {
+            format!(
+                "{}′",
+                input
+                    .face_names
+                    .get(f - input.arm_faces)
+                    .cloned()
+                    .unwrap_or(format!("#{f}"))
+            )
+        }
+    };
+    let vname = |v: usize| {
+        input
+            .vertex_names
+            .get(v)
+            .cloned()
+            .unwrap_or(format!("#{v}"))
+    };
+    // Relations of the face pairs that count: arm–arm and arm–copy (copy–copy pairs are
+    // arm–arm pairs turned by 180°).
+    let mut pairs: Vec<(usize, usize, Relation)> = Vec::new();
+    for fa in 0..input.arm_faces.min(nf) {
+        for fb in fa + 1..nf {
+            let shared: Vec<usize> = pat.faces[fa]
+                .iter()
+                .copied()
+                .filter(|v| pat.faces[fb].contains(v))
+                .collect();
+            let tips = input.tip.is_some_and(|(g, c)| {
+                fb >= input.arm_faces && pat.faces[fa].contains(&g) && pat.faces[fb].contains(&c)
+            });
+            let rel = match (shared.as_slice(), tips) {
+                ([], false) => Relation::Apart,
+                ([], true) => Relation::Tip,
+                ([v], false) => Relation::Wedge(*v),
+                // Touching at a shared vertex and at the tips: the intersection check's.
+                ([_], true) => continue,
+                _ => match checker
+                    .hinges()
+                    .iter()
+                    .position(|h| (h.face_a, h.face_b) == (fa, fb))
+                {
+                    Some(h) => Relation::Crease(h),
+                    None => continue,
+                },
+            };
+            pairs.push((fa, fb, rel));
+        }
+    }
+    let mut rigid = Least::new();
+    let mut own = Least::new();
+    let mut arm = Least::new();
+    let mut obstacle = Least::new();
+    for frame in &pat.frames {
+        let t = frame.t;
+        checker.validate_state(&frame.coords, t)?;
+        let x: Vec<V> = frame.coords.iter().map(|c| V::from(*c)).collect();
+        // Rigid margins from the folded crease directions.
+        if t != 0.0 {
+            let scale = (input.t_max / t).powi(2);
+            for u in &input.units {
+                let d = u.ends.map(|e| x[e] - x[u.vertex]);
+                let ang = |p: &V, q: &V| p.cross(q).norm().atan2(p.dot(q));
+                let (u1, u2, u3) = (ang(&d[2], &d[0]), ang(&d[0], &d[1]), ang(&d[1], &d[2]));
+                let m = (u2 + u3 - u1).min(u1 + u3 - u2).min(u1 + u2 - u3);
+                rigid.offer(m * scale, t, || u.label.clone());
+            }
+        }
+        // Bounding spheres of the faces for the pruning of far pairs.
+        let spheres: Vec<(V, f64)> = pat
+            .faces
+            .iter()
+            .map(|f| {
+                let c = f.iter().fold(V::zeros(), |s, v| s + x[*v]) / f.len() as f64;
+                let r = f.iter().map(|v| (x[*v] - c).norm()).fold(0.0, f64::max);
+                (c, r)
+            })
+            .collect();
+        let tri = |ix: &[usize; 3]| -> Tri { ix.map(|i| x[i]) };
+        for &(fa, fb, rel) in &pairs {
+            let least = if fb < input.arm_faces {
+                &mut own
+            } else {
+                &mut arm
+            };
+            match rel {
+                Relation::Apart => {
+                    let (ca, ra) = spheres[fa];
+                    let (cb, rb) = spheres[fb];
+                    if (ca - cb).norm() - ra - rb >= least.value {
+                        continue;
+                    }
+                    let d = tris[fa]
+                        .iter()
+                        .flat_map(|a| tris[fb].iter().map(move |b| (a, b)))
+                        .map(|(a, b)| triangle_distance(&tri(a), &tri(b)))
+                        .fold(f64::INFINITY, f64::min);
+                    least.offer(d, t, || {
+                        format!("facets {}–{}", face_name(fa), face_name(fb))
+                    });
+                }
+                Relation::Wedge(v) => {
+                    let theta = cone_angle(x[v], &pat.faces[fa], &pat.faces[fb], &x);
+                    let chord = 2.0 * (0.5 * theta).sin();
+                    least.offer(chord, t, || {
+                        format!("facets {}–{} at {}", face_name(fa), face_name(fb), vname(v))
+                    });
+                }
+                Relation::Tip => {
+                    let (g, c) = input.tip.expect("tip pairs need the tips");
+                    let theta = cone_angle((x[g] + x[c]) * 0.5, &pat.faces[fa], &pat.faces[fb], &x);
+                    let chord = 2.0 * (0.5 * theta).sin();
+                    least.offer(chord, t, || {
+                        format!("facets {}–{} at the tips", face_name(fa), face_name(fb))
+                    });
+                }
+                Relation::Crease(h) => {
+                    let hinge = &checker.hinges()[h];
+                    let rho = hinge.fold_angle(&frame.coords);
+                    let chord = 2.0 * (0.5 * (std::f64::consts::PI - rho.abs())).sin();
+                    least.offer(chord, t, || {
+                        format!(
+                            "crease {}–{} between facets {}–{}",
+                            vname(hinge.p),
+                            vname(hinge.q),
+                            face_name(fa),
+                            face_name(fb)
+                        )
+                    });
+                }
+            }
+        }
+        for (k, cyl) in input.cylinders.iter().enumerate() {
+            let (a, b) = (V::from(cyl.a), V::from(cyl.b));
+            for (f, ts) in tris.iter().enumerate() {
+                let (c, r) = spheres[f];
+                if point_segment_distance(&c, &a, &b) - r - cyl.radius >= obstacle.value {
+                    continue;
+                }
+                let d = ts
+                    .iter()
+                    .map(|ix| segment_triangle_distance(&a, &b, &tri(ix)))
+                    .fold(f64::INFINITY, f64::min)
+                    - cyl.radius;
+                obstacle.offer(d, t, || {
+                    format!("facet {} ↔ cylinder {}", face_name(f), k + 1)
+                });
+            }
+        }
+    }
+    let s = &input.settings;
+    let rigid_margin = rigid.report(s.rigid_margin).unwrap_or(MarginReport {
+        value: f64::INFINITY,
+        setting: s.rigid_margin,
+        t: None,
+        location: "no internal vertex".into(),
+    });
+    let mut report = RobustnessReport {
+        score: 0.0,
+        rigid_margin,
+        self_clearance: own.report(s.clearance),
+        arm_clearance: arm.report(s.clearance),
+        obstacle_clearance: obstacle.report(s.obstacle_clearance),
+        min_feature: None,
+    };
+    report.score = score(&report);
+    Ok(report)
+}
+
+/// The smallest margin over its setting (settings of 0 skipped); with every setting 0, over
+/// the defaults (1°, 1% of G0's crease) so designs still rank by how close they come.
+pub fn score(r: &RobustnessReport) -> f64 {
+    let ratio = |m: &MarginReport, default: f64| {
+        if m.setting > 0.0 {
+            (m.value / m.setting, true)
+        } else {
+            (m.value / default, false)
+        }
+    };
+    let all: Vec<(f64, bool)> = std::iter::once(ratio(&r.rigid_margin, DEFAULT_RIGID_MARGIN))
+        .chain(r.self_clearance.iter().map(|m| ratio(m, DEFAULT_CLEARANCE)))
+        .chain(r.arm_clearance.iter().map(|m| ratio(m, DEFAULT_CLEARANCE)))
+        .chain(
+            r.obstacle_clearance
+                .iter()
+                .map(|m| ratio(m, DEFAULT_CLEARANCE)),
+        )
+        .filter(|(v, _)| v.is_finite())
+        .collect();
+    let set: Vec<f64> = all.iter().filter(|(_, s)| *s).map(|(v, _)| *v).collect();
+    let pick = if set.is_empty() {
+        all.iter().map(|(v, _)| *v).collect()
+    } else {
+        set
+    };
+    pick.into_iter().fold(f64::INFINITY, f64::min)
+}
+
+/// Closest point of triangle `t` to `p` (Ericson, Real-Time Collision Detection, 5.1.5).
+fn closest_on_triangle(p: &V, t: &Tri) -> V {
+    let (a, b, c) = (t[0], t[1], t[2]);
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
+}
+
+/// Distance between segments `p1 q1` and `p2 q2` (Ericson 5.1.9).
+fn segment_distance(p1: &V, q1: &V, p2: &V, q2: &V) -> f64 {
+    let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
+    let (a, e, f) = (d1.dot(&d1), d2.dot(&d2), d2.dot(&r));
+    let eps = 1e-300;
+    let (s, t) = if a <= eps && e <= eps {
+        (0.0, 0.0)
+    } else if a <= eps {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(&r);
+        if e <= eps {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(&d2);
+            let denom = a * e - b * b;
+            let mut s = if denom > 0.0 {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let mut t = (b * s + f) / e;
+            if t < 0.0 {
+                t = 0.0;
+                s = (-c / a).clamp(0.0, 1.0);
+            } else if t > 1.0 {
+                t = 1.0;
+                s = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            (s, t)
+        }
+    };
+    ((p1 + d1 * s) - (p2 + d2 * t)).norm()
+}
+
+/// Distance from `p` to segment `a b`.
+fn point_segment_distance(p: &V, a: &V, b: &V) -> f64 {
+    let ab = b - a;
+    let l = ab.norm_squared();
+    let s = if l > 0.0 {
+        ((p - a).dot(&ab) / l).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * s)).norm()
+}
+
+/// Exact distance between two triangles (0 when they cross).
+pub fn triangle_distance(a: &Tri, b: &Tri) -> f64 {
+    if triangles_intersect(a, b, 0.0) {
+        return 0.0;
+    }
+    let mut d = f64::INFINITY;
+    for p in a {
+        d = d.min((p - closest_on_triangle(p, b)).norm());
+    }
+    for p in b {
+        d = d.min((p - closest_on_triangle(p, a)).norm());
+    }
+    for i in 0..3 {
+        for j in 0..3 {
+            d = d.min(segment_distance(
+                &a[i],
+                &a[(i + 1) % 3],
+                &b[j],
+                &b[(j + 1) % 3],
+            ));
+        }
+    }
+    d
+}
+
+/// Exact distance between segment `p q` and a triangle (0 when it pierces it).
+pub fn segment_triangle_distance(p: &V, q: &V, t: &Tri) -> f64 {
+    let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+    let (dp, dq) = (n.dot(&(p - t[0])), n.dot(&(q - t[0])));
+    if dp * dq <= 0.0 && dp != dq {
+        let x = p + (q - p) * (dp / (dp - dq));
+        if (x - closest_on_triangle(&x, t)).norm() <= 1e-15 * (1.0 + x.norm()) {
+            return 0.0;
+        }
+    }
+    let mut d = (p - closest_on_triangle(p, t))
+        .norm()
+        .min((q - closest_on_triangle(q, t)).norm());
+    for j in 0..3 {
+        d = d.min(segment_distance(p, q, &t[j], &t[(j + 1) % 3]));
+    }
+    d
+}
+
+/// Angle from unit vector `p` to the arc from `e1` to `e2` (shorter than π) on the sphere.
+fn point_arc_angle(p: &V, e1: &V, e2: &V) -> f64 {
+    let ang = |a: &V, b: &V| a.cross(b).norm().atan2(a.dot(b));
+    let end = ang(p, e1).min(ang(p, e2));
+    let Some(m) = e1.cross(e2).try_normalize(1e-300) else {
+        return end;
+    };
+    let q = p - m * p.dot(&m);
+    if q.norm() > 1e-300 && e1.cross(&q).dot(&m) >= 0.0 && q.cross(e2).dot(&m) >= 0.0 {
+        return p.dot(&m).abs().atan2(q.norm()).min(end);
+    }
+    end
+}
+
+/// Whether the arcs `a1 → a2` and `b1 → b2` (each shorter than π, on different great
+/// circles) cross.
+fn arcs_cross(a1: &V, a2: &V, b1: &V, b2: &V) -> bool {
+    let (Some(ma), Some(mb)) = (
+        a1.cross(a2).try_normalize(1e-300),
+        b1.cross(b2).try_normalize(1e-300),
+    ) else {
+        return false;
+    };
+    let Some(l) = ma.cross(&mb).try_normalize(1e-12) else {
+        // One great circle: overlapping arcs show as a zero point–arc distance.
+        return false;
+    };
+    let on =
+        |q: &V, e1: &V, e2: &V, m: &V| e1.cross(q).dot(m) >= -1e-15 && q.cross(e2).dot(m) >= -1e-15;
+    [l, -l]
+        .iter()
+        .any(|q| on(q, a1, a2, &ma) && on(q, b1, b2, &mb))
+}
+
+/// Whether unit vector `u` lies inside the spherical polygon `poly` (vertices in order,
+/// spanning less than a hemisphere): the crossing number in the gnomonic projection about
+/// the polygon's mean direction, which maps its arcs to straight segments.
+fn inside_spherical(u: &V, poly: &[V]) -> bool {
+    let Some(c) = poly
+        .iter()
+        .fold(V::zeros(), |s, p| s + p)
+        .try_normalize(1e-300)
+    else {
+        return false;
+    };
+    if u.dot(&c) <= 1e-12 || poly.iter().any(|p| p.dot(&c) <= 1e-12) {
+        return false;
+    }
+    let e1 = if c.x.abs() < 0.9 { V::x() } else { V::y() };
+    let e1 = c.cross(&e1).normalize();
+    let e2 = c.cross(&e1);
+    let proj = |p: &V| {
+        let q = p / p.dot(&c);
+        (q.dot(&e1), q.dot(&e2))
+    };
+    let (px, py) = proj(u);
+    let pts: Vec<(f64, f64)> = poly.iter().map(proj).collect();
+    let mut inside = false;
+    for k in 0..pts.len() {
+        let (ax, ay) = pts[k];
+        let (bx, by) = pts[(k + 1) % pts.len()];
+        if (ay > py) != (by > py) && px < ax + (py - ay) / (by - ay) * (bx - ax) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// The angle between the cones from `apex` over two faces (vertex lists into `x`): 0 when
+/// they overlap, else the least angle from a vertex direction of one to an edge arc of the
+/// other. A face through the apex gives a planar cone (its arcs lie on one great circle).
+fn cone_angle(apex: V, fa: &[usize], fb: &[usize], x: &[V]) -> f64 {
+    let dirs = |f: &[usize]| -> Vec<V> {
+        f.iter()
+            .filter_map(|v| (x[*v] - apex).try_normalize(1e-12))
+            .collect()
+    };
+    let (da, db) = (dirs(fa), dirs(fb));
+    if da.is_empty() || db.is_empty() {
+        return std::f64::consts::PI;
+    }
+    let arcs = |d: &[V]| -> Vec<(V, V)> {
+        match d.len() {
+            1 => Vec::new(),
+            2 => vec![(d[0], d[1])],
+            n => (0..n).map(|k| (d[k], d[(k + 1) % n])).collect(),
+        }
+    };
+    let (aa, ab) = (arcs(&da), arcs(&db));
+    for (a1, a2) in &aa {
+        for (b1, b2) in &ab {
+            if arcs_cross(a1, a2, b1, b2) {
+                return 0.0;
+            }
+        }
+    }
+    if db.iter().any(|u| inside_spherical(u, &da)) || da.iter().any(|u| inside_spherical(u, &db)) {
+        return 0.0;
+    }
+    let ang = |a: &V, b: &V| a.cross(b).norm().atan2(a.dot(b));
+    let mut best = f64::INFINITY;
+    for (p, arcs) in da
+        .iter()
+        .map(|p| (p, &ab))
+        .chain(db.iter().map(|p| (p, &aa)))
+    {
+        for (e1, e2) in arcs.iter() {
+            best = best.min(point_arc_angle(p, e1, e2));
+        }
+    }
+    for p in &da {
+        for q in &db {
+            best = best.min(ang(p, q));
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn t(p: [[f64; 3]; 3]) -> Tri {
+        p.map(V::from)
+    }
+
+    /// The distance between two triangles is the least distance between points of them:
+    /// dense sampling of both (barycentric grid) never goes below it and comes within the
+    /// grid's resolution of it.
+    #[test]
+    fn triangle_distance_matches_sampling() {
+        let cases = [
+            (
+                t([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+                t([[0.2, 0.3, 0.5], [1.0, 1.0, 0.8], [-0.5, 1.0, 1.5]]),
+            ),
+            (
+                t([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+                t([[1.5, 1.5, -1.0], [1.5, 1.5, 1.0], [3.0, 0.0, 0.0]]),
+            ),
+            (
+                t([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]),
+                t([[0.5, 0.5, 0.3], [0.6, 0.4, 2.0], [0.4, 0.7, 2.5]]),
+            ),
+        ];
+        let n = 60;
+        let pts = |tr: &Tri| -> Vec<V> {
+            let mut out = Vec::new();
+            for i in 0..=n {
+                for j in 0..=n - i {
+                    let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                    out.push(tr[0] + (tr[1] - tr[0]) * u + (tr[2] - tr[0]) * v);
+                }
+            }
+            out
+        };
+        for (a, b) in &cases {
+            let d = triangle_distance(a, b);
+            let (pa, pb) = (pts(a), pts(b));
+            let sampled = pa
+                .iter()
+                .flat_map(|p| pb.iter().map(move |q| (p - q).norm()))
+                .fold(f64::INFINITY, f64::min);
+            assert!(sampled >= d - 1e-12, "{sampled} < {d}");
+            assert!(sampled - d < 0.05, "{sampled} vs {d}");
+        }
+        // Crossing triangles are at distance 0.
+        let a = t([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
+        let b = t([[0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [1.5, -1.0, 0.0]]);
+        assert_eq!(triangle_distance(&a, &b), 0.0);
+    }
+
+    #[test]
+    fn segment_triangle_distance_is_exact() {
+        let tri = t([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+        // Parallel above the interior.
+        let d = segment_triangle_distance(&V::new(0.1, 0.1, 0.3), &V::new(0.3, 0.1, 0.3), &tri);
+        assert!((d - 0.3).abs() < 1e-15);
+        // Piercing.
+        let d = segment_triangle_distance(&V::new(0.2, 0.2, -1.0), &V::new(0.2, 0.2, 1.0), &tri);
+        assert_eq!(d, 0.0);
+        // Beyond an edge: closest to the edge x + y = 1 from (1, 1, 0) along z.
+        let d = segment_triangle_distance(&V::new(1.0, 1.0, -1.0), &V::new(1.0, 1.0, 1.0), &tri);
+        assert!((d - 0.5_f64.sqrt()).abs() < 1e-15, "{d}");
+    }
+
+    #[test]
+    fn cone_angle_of_two_wedges() {
+        // Apex at the origin; face A in the xy-plane between +x and +y, face B in the
+        // plane z = 0 rotated up about the y-axis … simplest: B between directions at
+        // angles 120° and 150° in the xy-plane, so 30° from A's edge +y.
+        let x = [
+            V::zeros(),
+            V::new(1.0, 0.0, 0.0),
+            V::new(0.0, 1.0, 0.0),
+            V::new(
+                (120f64).to_radians().cos(),
+                (120f64).to_radians().sin(),
+                0.0,
+            ),
+            V::new(
+                (150f64).to_radians().cos(),
+                (150f64).to_radians().sin(),
+                0.0,
+            ),
+        ];
+        let th = cone_angle(x[0], &[0, 1, 2], &[0, 3, 4], &x);
+        assert!((th - 30f64.to_radians()).abs() < 1e-12, "{th}");
+        // Lift B out of the plane: rotate its points about the y-axis… the angle to A's
+        // cone is then the angle of its nearest ray to the quarter plane.
+        let up = |p: V| V::new(p.x, p.y * 0.5f64.cos(), p.y * 0.5f64.sin());
+        let x2 = [x[0], x[1], x[2], up(x[3]), up(x[4])];
+        let th2 = cone_angle(x2[0], &[0, 1, 2], &[0, 3, 4], &x2);
+        let ray = up(x[3]).normalize();
+        let want = point_arc_angle(&ray, &x[1], &x[2]);
+        assert!((th2 - want).abs() < 1e-12 && th2 > th, "{th2} {want}");
+        // Overlapping wedges: 0.
+        let x3 = [
+            x[0],
+            x[1],
+            x[2],
+            V::new(0.5, 0.5, 0.0),
+            V::new(-1.0, 0.2, 0.0),
+        ];
+        assert_eq!(cone_angle(x3[0], &[0, 1, 2], &[0, 3, 4], &x3), 0.0);
+        // Crossing out of plane: B's arc pierces A's quarter plane.
+        let x4 = [
+            x[0],
+            x[1],
+            x[2],
+            V::new(0.5, 0.5, 1.0),
+            V::new(0.5, 0.5, -1.0),
+        ];
+        assert_eq!(cone_angle(x4[0], &[0, 1, 2], &[0, 3, 4], &x4), 0.0);
+    }
+}

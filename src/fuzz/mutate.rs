@@ -1,0 +1,565 @@
+//! Making inputs: structure-aware mutations (TOML and JSON value trees of the seeds,
+//! grammar generators for the notations) and byte-level mutations of the seeds.
+
+use rand::RngExt;
+use rand_chacha::ChaCha8Rng;
+
+use super::{Target, generate, seeds};
+
+/// Largest input made (a few are larger by a deep nesting insert).
+const MAX_LEN: usize = 256 << 10;
+
+/// Tokens worth inserting anywhere.
+const TOKENS: [&str; 40] = [
+    "1e308",
+    "-1e308",
+    "1e309",
+    "nan",
+    "inf",
+    "-inf",
+    "NaN",
+    "Infinity",
+    "5e-324",
+    "0",
+    "-0",
+    "18446744073709551616",
+    "-9223372036854775809",
+    "4294967296",
+    "\"\"",
+    "[]",
+    "{}",
+    "null",
+    "true",
+    "\"pi\"",
+    "t",
+    "(",
+    ")",
+    ",",
+    "\"../..\"",
+    "\"/etc/passwd\"",
+    "\\u0000",
+    "\n",
+    "\"",
+    "'",
+    "=",
+    "[[",
+    "]]",
+    "#",
+    "\u{202e}",
+    "é",
+    "∅",
+    "χ",
+    "\"x\" = 1\n",
+    "1e-400",
+];
+
+/// Strings worth putting into a value.
+const STRINGS: [&str; 22] = [
+    "",
+    "pi",
+    "t",
+    "-t",
+    "1/0",
+    "0/0",
+    "sqrt(-1)",
+    "../../victim",
+    "/abs/path",
+    "a/b",
+    "B",
+    "M",
+    "V",
+    "C",
+    "creasePattern",
+    "foldedForm",
+    "up",
+    "down",
+    "extendable",
+    "terminal",
+    "pi/0",
+    "((((((((((((t))))))))))))",
+];
+
+/// Keys the formats use (for inserting fields).
+const KEYS: [&str; 26] = [
+    "vertices_coords",
+    "edges_vertices",
+    "faces_vertices",
+    "edges_assignment",
+    "edges_foldAngle",
+    "frame_classes",
+    "file_frames",
+    "frame_parent",
+    "frame_inherit",
+    "foldsynth:t",
+    "edges_foldsynth:driven",
+    "pattern",
+    "meta",
+    "frames",
+    "coords",
+    "fold_angles",
+    "name",
+    "n_max",
+    "xy",
+    "type",
+    "drive",
+    "states",
+    "t_max",
+    "rotations",
+    "steps",
+    "key",
+];
+
+/// Numbers worth putting into a value.
+const FLOATS: [f64; 16] = [
+    0.0,
+    -0.0,
+    1.0,
+    -1.0,
+    0.5,
+    1e-9,
+    1e-300,
+    5e-324,
+    1e6,
+    1e7,
+    1e15,
+    1e308,
+    -1e308,
+    f64::MAX,
+    180.0,
+    std::f64::consts::PI,
+];
+
+const INTEGERS: [i64; 12] = [
+    0,
+    1,
+    -1,
+    2,
+    3,
+    6,
+    7,
+    1000,
+    4_000_000_000,
+    i64::MAX,
+    i64::MIN,
+    1 << 40,
+];
+
+/// One input for `target`.
+pub fn make(target: Target, rng: &mut ChaCha8Rng) -> Vec<u8> {
+    let all = seeds::of(target);
+    let seed = &all[rng.random_range(0..all.len())];
+    match rng.random_range(0..10) {
+        0..=3 => structured(target, seed, rng),
+        4..=7 => bytes(seed, all, rng),
+        8 => bytes(&structured(target, seed, rng), all, rng),
+        _ => match target {
+            Target::Vertex => generate::vertex(rng).into_bytes(),
+            Target::Expr => generate::expr(rng, 6).into_bytes(),
+            _ => seed.clone(),
+        },
+    }
+}
+
+/// A structure-aware mutation of `seed` (a generated input for the notations).
+fn structured(target: Target, seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
+    match target {
+        Target::Vertex => generate::vertex(rng).into_bytes(),
+        Target::Expr => generate::expr(rng, 5).into_bytes(),
+        Target::Task | Target::Pattern => toml_tree(seed, rng),
+        Target::Fold | Target::Design => json_tree(seed, rng),
+        Target::Records => records(seed, rng),
+    }
+}
+
+/// A path into a value tree.
+enum Step {
+    Index(usize),
+    Key(String),
+}
+
+fn json_path(v: &serde_json::Value, rng: &mut ChaCha8Rng) -> Vec<Step> {
+    let mut path = Vec::new();
+    let mut v = v;
+    loop {
+        if rng.random_bool(0.25) {
+            return path;
+        }
+        match v {
+            serde_json::Value::Array(a) if !a.is_empty() => {
+                let i = rng.random_range(0..a.len());
+                path.push(Step::Index(i));
+                v = &a[i];
+            }
+            serde_json::Value::Object(o) if !o.is_empty() => {
+                let i = rng.random_range(0..o.len());
+                let Some((k, next)) = o.iter().nth(i) else {
+                    return path;
+                };
+                path.push(Step::Key(k.clone()));
+                v = next;
+            }
+            _ => return path,
+        }
+    }
+}
+
+fn json_at<'a>(
+    mut v: &'a mut serde_json::Value,
+    path: &[Step],
+) -> Option<&'a mut serde_json::Value> {
+    for s in path {
+        v = match (v, s) {
+            (serde_json::Value::Array(a), Step::Index(i)) => a.get_mut(*i)?,
+            (serde_json::Value::Object(o), Step::Key(k)) => o.get_mut(k)?,
+            _ => return None,
+        };
+    }
+    Some(v)
+}
+
+fn json_value(rng: &mut ChaCha8Rng) -> serde_json::Value {
+    use serde_json::{Value, json};
+    match rng.random_range(0..9) {
+        0 | 1 => json!(FLOATS[rng.random_range(0..FLOATS.len())]),
+        2 => json!(INTEGERS[rng.random_range(0..INTEGERS.len())]),
+        3 => json!(STRINGS[rng.random_range(0..STRINGS.len())]),
+        4 => Value::Null,
+        5 => json!(rng.random_bool(0.5)),
+        6 => json!([]),
+        7 => json!({}),
+        _ => {
+            let n = rng.random_range(0..5);
+            Value::Array((0..n).map(|_| json!(rng.random_range(-3.0..3.0))).collect())
+        }
+    }
+}
+
+fn mutate_json(node: &mut serde_json::Value, rng: &mut ChaCha8Rng) {
+    use serde_json::Value;
+    match rng.random_range(0..9) {
+        0 | 1 => *node = json_value(rng),
+        2 => {
+            if let Value::Array(a) = node
+                && !a.is_empty()
+            {
+                let i = rng.random_range(0..a.len());
+                a.remove(i);
+            }
+        }
+        3 => {
+            if let Value::Array(a) = node
+                && !a.is_empty()
+                && a.len() < 5000
+            {
+                let i = rng.random_range(0..a.len());
+                let x = a[i].clone();
+                a.insert(i, x);
+            }
+        }
+        4 => {
+            if let Value::Object(o) = node
+                && !o.is_empty()
+            {
+                let i = rng.random_range(0..o.len());
+                if let Some(k) = o.keys().nth(i).cloned() {
+                    o.remove(&k);
+                }
+            }
+        }
+        5 => {
+            if let Value::Object(o) = node {
+                o.insert(
+                    KEYS[rng.random_range(0..KEYS.len())].into(),
+                    json_value(rng),
+                );
+            }
+        }
+        6 => {
+            if let Some(x) = node.as_f64() {
+                let f = [-1.0, 1e6, 1e-6, 1.0 + 1e-7, 0.0, 2.0][rng.random_range(0..6)];
+                if let Some(n) = serde_json::Number::from_f64(x * f) {
+                    *node = Value::Number(n);
+                }
+            }
+        }
+        7 => {
+            if let Value::Array(a) = node {
+                let n = rng.random_range(0..=a.len());
+                a.truncate(n);
+            }
+        }
+        _ => {
+            // Nest the node deep.
+            for _ in 0..rng.random_range(1..200) {
+                *node = Value::Array(vec![node.take()]);
+            }
+        }
+    }
+}
+
+fn json_tree(seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
+    let Ok(mut v) = serde_json::from_slice::<serde_json::Value>(seed) else {
+        return seed.to_vec();
+    };
+    for _ in 0..rng.random_range(1..5) {
+        let path = json_path(&v, rng);
+        if let Some(node) = json_at(&mut v, &path) {
+            mutate_json(node, rng);
+        }
+    }
+    serde_json::to_vec(&v).unwrap_or_else(|_| seed.to_vec())
+}
+
+fn toml_path(v: &toml::Value, rng: &mut ChaCha8Rng) -> Vec<Step> {
+    let mut path = Vec::new();
+    let mut v = v;
+    loop {
+        if rng.random_bool(0.2) {
+            return path;
+        }
+        match v {
+            toml::Value::Array(a) if !a.is_empty() => {
+                let i = rng.random_range(0..a.len());
+                path.push(Step::Index(i));
+                v = &a[i];
+            }
+            toml::Value::Table(t) if !t.is_empty() => {
+                let i = rng.random_range(0..t.len());
+                let Some((k, next)) = t.iter().nth(i) else {
+                    return path;
+                };
+                path.push(Step::Key(k.clone()));
+                v = next;
+            }
+            _ => return path,
+        }
+    }
+}
+
+fn toml_at<'a>(mut v: &'a mut toml::Value, path: &[Step]) -> Option<&'a mut toml::Value> {
+    for s in path {
+        v = match (v, s) {
+            (toml::Value::Array(a), Step::Index(i)) => a.get_mut(*i)?,
+            (toml::Value::Table(t), Step::Key(k)) => t.get_mut(k)?,
+            _ => return None,
+        };
+    }
+    Some(v)
+}
+
+fn toml_value(rng: &mut ChaCha8Rng) -> toml::Value {
+    use toml::Value;
+    match rng.random_range(0..9) {
+        0 => Value::Float(FLOATS[rng.random_range(0..FLOATS.len())]),
+        1 => Value::Float([f64::NAN, f64::INFINITY, f64::NEG_INFINITY][rng.random_range(0..3)]),
+        2 => Value::Integer(INTEGERS[rng.random_range(0..INTEGERS.len())]),
+        3 => Value::String(STRINGS[rng.random_range(0..STRINGS.len())].into()),
+        4 => Value::Boolean(rng.random_bool(0.5)),
+        5 => Value::Array(Vec::new()),
+        6 => Value::Table(toml::Table::new()),
+        7 => Value::String("x".repeat(rng.random_range(100..20_000))),
+        _ => {
+            let n = rng.random_range(0..5);
+            Value::Array(
+                (0..n)
+                    .map(|_| Value::Float(rng.random_range(-3.0..3.0)))
+                    .collect(),
+            )
+        }
+    }
+}
+
+fn mutate_toml(node: &mut toml::Value, rng: &mut ChaCha8Rng) {
+    use toml::Value;
+    match rng.random_range(0..9) {
+        0 | 1 => *node = toml_value(rng),
+        2 => {
+            if let Value::Array(a) = node
+                && !a.is_empty()
+            {
+                let i = rng.random_range(0..a.len());
+                a.remove(i);
+            }
+        }
+        3 => {
+            if let Value::Array(a) = node
+                && !a.is_empty()
+                && a.len() < 5000
+            {
+                let i = rng.random_range(0..a.len());
+                let x = a[i].clone();
+                a.insert(i, x);
+            }
+        }
+        4 => {
+            if let Value::Table(t) = node
+                && !t.is_empty()
+            {
+                let i = rng.random_range(0..t.len());
+                if let Some(k) = t.keys().nth(i).cloned() {
+                    t.remove(&k);
+                }
+            }
+        }
+        5 => {
+            if let Value::Table(t) = node {
+                t.insert(
+                    KEYS[rng.random_range(0..KEYS.len())].into(),
+                    toml_value(rng),
+                );
+            }
+        }
+        6 => match node {
+            Value::Float(x) => *x *= [-1.0, 1e6, 1e-6, 1.0 + 1e-7, 0.0][rng.random_range(0..5)],
+            Value::Integer(i) => {
+                *i = i.wrapping_mul([-1, 1000, 0, 2, 1 << 20][rng.random_range(0..5)])
+            }
+            _ => {}
+        },
+        7 => {
+            if let Value::Array(a) = node {
+                let n = rng.random_range(0..=a.len());
+                a.truncate(n);
+            }
+        }
+        _ => {
+            for _ in 0..rng.random_range(1..100) {
+                let inner = std::mem::replace(node, Value::Boolean(false));
+                *node = Value::Array(vec![inner]);
+            }
+        }
+    }
+}
+
+fn toml_tree(seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
+    let Some(mut v) = std::str::from_utf8(seed)
+        .ok()
+        .and_then(|s| s.parse::<toml::Table>().ok())
+        .map(toml::Value::Table)
+    else {
+        return seed.to_vec();
+    };
+    for _ in 0..rng.random_range(1..5) {
+        let path = toml_path(&v, rng);
+        if let Some(node) = toml_at(&mut v, &path) {
+            mutate_toml(node, rng);
+        }
+    }
+    match v {
+        toml::Value::Table(t) => toml::to_string(&t)
+            .map(String::into_bytes)
+            .unwrap_or_else(|_| seed.to_vec()),
+        _ => seed.to_vec(),
+    }
+}
+
+/// Records: lines mutated as JSON, repeated, dropped, reordered, torn.
+fn records(seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
+    let mut lines: Vec<Vec<u8>> = seed
+        .split(|&b| b == b'\n')
+        .filter(|l| !l.is_empty())
+        .map(<[u8]>::to_vec)
+        .collect();
+    for _ in 0..rng.random_range(1..4) {
+        if lines.is_empty() {
+            break;
+        }
+        let i = rng.random_range(0..lines.len());
+        match rng.random_range(0..6) {
+            0 | 1 => lines[i] = json_tree(&lines[i], rng),
+            2 => {
+                let l = lines[i].clone();
+                lines.insert(rng.random_range(0..=lines.len()), l);
+            }
+            3 => {
+                lines.remove(i);
+            }
+            4 => {
+                let j = rng.random_range(0..lines.len());
+                lines.swap(i, j);
+            }
+            _ => {
+                let n = rng.random_range(0..=lines[i].len());
+                lines[i].truncate(n);
+            }
+        }
+    }
+    let mut out = lines.join(&b'\n');
+    if rng.random_range(0..4) != 0 {
+        out.push(b'\n');
+    }
+    out
+}
+
+/// Byte-level mutations of `seed` (with splices from `all`).
+fn bytes(seed: &[u8], all: &[Vec<u8>], rng: &mut ChaCha8Rng) -> Vec<u8> {
+    let mut b = seed.to_vec();
+    for _ in 0..rng.random_range(1..7) {
+        let len = b.len();
+        let pos = if len == 0 {
+            0
+        } else {
+            rng.random_range(0..=len)
+        };
+        match rng.random_range(0..10) {
+            0 if len > 0 => {
+                let i = pos.min(len - 1);
+                b[i] ^= 1 << rng.random_range(0..8);
+            }
+            1 if len > 0 => {
+                let i = pos.min(len - 1);
+                b[i] = rng.random_range(0x20..0x7f);
+            }
+            2 | 3 => {
+                let tok = TOKENS[rng.random_range(0..TOKENS.len())].as_bytes();
+                b.splice(pos..pos, tok.iter().copied());
+            }
+            4 => {
+                let n = rng.random_range(1..32).min(len - pos);
+                b.drain(pos..pos + n);
+            }
+            5 => {
+                let n = rng.random_range(1..64).min(len - pos);
+                let chunk = b[pos..pos + n].to_vec();
+                b.splice(pos..pos, chunk);
+            }
+            6 => {
+                let other = &all[rng.random_range(0..all.len())];
+                let from = if other.is_empty() {
+                    0
+                } else {
+                    rng.random_range(0..other.len())
+                };
+                b.truncate(pos);
+                b.extend_from_slice(&other[from..]);
+            }
+            7 => {
+                // A number replaced by an interesting one.
+                if let Some(start) = (pos..len).find(|&i| b[i].is_ascii_digit()) {
+                    let end = (start..len)
+                        .find(|&i| !(b[i].is_ascii_digit() || b[i] == b'.'))
+                        .unwrap_or(len);
+                    let n = generate::NUMBERS[rng.random_range(0..generate::NUMBERS.len())];
+                    b.splice(start..end, n.bytes());
+                }
+            }
+            8 => b.truncate(pos),
+            _ => {
+                // Deep nesting.
+                let (open, close) =
+                    [(b'(', b')'), (b'[', b']'), (b'{', b'}')][rng.random_range(0..3)];
+                let n = rng.random_range(1..100_000);
+                let mut nest = vec![open; n];
+                if rng.random_bool(0.5) {
+                    nest.push(b't');
+                    nest.extend(std::iter::repeat_n(close, n));
+                }
+                b.splice(pos..pos, nest);
+            }
+        }
+        if b.len() > MAX_LEN && rng.random_range(0..4) != 0 {
+            b.truncate(MAX_LEN);
+        }
+    }
+    b
+}

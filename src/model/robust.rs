@@ -1,0 +1,848 @@
+//! The robustness block of a model (issue 12): clearance and rigid-margin constraints at
+//! the states of the motion the optimizer samples, compiled with the rest of the model.
+//!
+//! ## What is compiled
+//!
+//! Per graph and gripping candidate, two native functions built from the same generic
+//! kinematics as the model ([`super::geometry`] on symbols, then egg → reverse mode →
+//! Cranelift), with the modes and `t` as parameters:
+//! - **values**: every vertex position, every Eq. 25 margin `U_j + U_k − U_i` and every
+//!   crease's fold angle at `t`;
+//! - **pullback**: `S = Σ w_i·X_i + Σ u_k m_k + Σ r_c ρ_c` with the weights as parameters,
+//!   and its gradient with respect to the design variables.
+//!
+//! Every constraint of the block is a smooth function `h(X, m, ρ)` of those values (the
+//! separating-plane constraints of [`super::clearance`] are linear in `X` for a given
+//! plane), so the gradient of the block's augmented-Lagrangian term,
+//! `Σ_k ∂φ/∂h_k ∇h_k`, is the gradient of `S` with `w = Σ_k ∂φ/∂h_k ∂h_k/∂X`, etc.: one
+//! reverse sweep, exact (no finite differences), whatever the number of constraints. The
+//! compile cost does not grow with the number of facet pairs; each sampled state costs
+//! one call of each function per evaluation, and states with no constraint near its bound
+//! are skipped.
+//!
+//! ## The constraints, at each sampled state t
+//!
+//! - clearance between facets, to the rotated copy and to the cylinders
+//!   ([`super::clearance`]);
+//! - creases stay `2 asin(clearance/2)` short of folding flat (|ρ| ≤ π − that);
+//! - rigid foldability with margin: `U_j + U_k − U_i ≥ rigid_margin · (t/t_max)²` for
+//!   t > 0. At the flat state every vertex whose first unit spans more than π has a
+//!   degenerate vertex triangle (`U_1 = 2π − Σα = U_2 + U_3` by developability, for any
+//!   sector angles), and its margin — and the effect of a sector error on it — grows as t²
+//!   from there; at t_max the full margin applies, over the motion its t² share.
+//!
+//! Each requirement is imposed with a 1% safety over its setting (plus a floor that keeps
+//! zero settings strictly clear of contact), so states between the ones sampled keep the
+//! setting; a design is accepted only when a finer sweep (the search's verification
+//! sweep) holds with half that safety, and states where it does not are added.
+
+use super::clearance::{self, Buffers, Effort, Group, Pair, PairKind, Pairs, Plane, Scene, VRef};
+use super::{Model, RIGID_MARGIN, geometry};
+use crate::compile::{self, Compiled, Options};
+use crate::expr::{Ctx, Sym};
+use crate::geom::V3;
+use crate::kinematics::{Scalar, wrap_angle};
+use crate::optimize::{Acceptance, Robust};
+use crate::task::{Cylinder, Robustness, Task};
+use std::cell::RefCell;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// Relative safety over each setting at the sampled states (half of it on the sweep).
+pub const SAFETY: f64 = 1e-2;
+/// Smallest clearance imposed (paper units), so that a setting of 0 still keeps facets off
+/// contact (the Möller check's tolerance is 1e-9).
+pub const CLEARANCE_FLOOR: f64 = 1e-6;
+/// Pairs whose bounding spheres are farther apart than the required gap plus this (paper
+/// units; radians for cones) get no plane.
+const ACTIVATE: f64 = 0.05;
+/// A sampled state joins the merit while one of its constraints is within this of its
+/// bound (or carries a multiplier).
+const LIVE: f64 = 0.05;
+
+/// Plane fits between outer iterations: the optimizer's planes.
+const FIT: Effort = Effort {
+    enough: LIVE,
+    iters: 32,
+    tol: 1e-10,
+    axes: true,
+};
+/// Plane fits on the acceptance sweep: any plane that shows the gap will do.
+const SWEEP_FIT: Effort = Effort {
+    enough: 0.0,
+    iters: 32,
+    tol: 1e-9,
+    axes: false,
+};
+/// At most this many states are added to the sampled ones per start.
+const MAX_ADDED_STATES: usize = 24;
+
+/// The block's settings for one task.
+#[derive(Clone, Debug)]
+pub struct RobustSpec {
+    /// The task's `[robustness]`.
+    pub settings: Robustness,
+    /// Evenly spaced states over [0, t_max] where the constraints are imposed.
+    pub states: usize,
+    /// States of the finer sweep a design must also pass.
+    pub sweep: usize,
+    /// Two-armed task: the rotated copy is kept clear of the arm.
+    pub second_arm: bool,
+    /// Obstacles.
+    pub cylinders: Vec<Cylinder>,
+}
+
+impl RobustSpec {
+    /// The settings of `task`, with the verification sweep of `sweep` states.
+    pub fn from_task(task: &Task, sweep: usize) -> RobustSpec {
+        let check = task.check.as_ref();
+        RobustSpec {
+            settings: task.robustness,
+            states: check.map_or(crate::task::DEFAULT_OPTIMIZE_STATES, |c| c.optimize_states),
+            sweep: sweep.max(2),
+            second_arm: check.is_some_and(|c| c.second_arm),
+            cylinders: check.map(|c| c.cylinders.clone()).unwrap_or_default(),
+        }
+    }
+}
+
+/// How strictly a requirement is read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Level {
+    /// What the optimizer imposes at the sampled states (setting + safety).
+    Imposed,
+    /// What a design must keep on the finer sweep (setting + half the safety).
+    Accept,
+    /// The setting itself.
+    Setting,
+}
+
+impl Level {
+    fn factor(self) -> f64 {
+        match self {
+            Level::Imposed => 1.0 + SAFETY,
+            Level::Accept => 1.0 + 0.5 * SAFETY,
+            Level::Setting => 1.0,
+        }
+    }
+}
+
+/// What a constraint depends on: vertex positions (with `∂h/∂x`), a margin or a fold angle
+/// (with `∂h/∂·`).
+#[derive(Clone, Copy, Debug)]
+pub enum Dep<'a> {
+    /// Positions of the vertices involved and the gradient of `h` with respect to each.
+    X(&'a [(VRef, V3)]),
+    /// Margin `k` (vertex `k / 3`, margin `k % 3`), `∂h/∂m = 1`.
+    Margin(usize),
+    /// Fold angle of crease `creases[c]` with `∂h/∂ρ`.
+    Rho(usize, f64),
+}
+
+/// The values the block reads at one state.
+#[derive(Clone, Debug, Default)]
+pub struct StateValues {
+    /// Vertex positions, their copies and the facets' bounding spheres.
+    pub scene: Scene,
+    /// Margins, three per internal vertex (extension order).
+    pub margins: Vec<f64>,
+    /// Fold angles of the constrained creases.
+    pub rho: Vec<f64>,
+}
+
+/// Buffers for evaluating the block (one per alternative: no allocation per evaluation).
+#[derive(Clone, Debug, Default)]
+pub struct Work {
+    params: Vec<f64>,
+    out: Vec<f64>,
+    x: Vec<V3>,
+    /// The values of the last state evaluated.
+    pub values: StateValues,
+    buffers: Buffers,
+    weights: Vec<f64>,
+}
+
+/// The compiled robustness block of one model.
+#[derive(Debug)]
+pub struct RobustModel {
+    /// Pairs of pieces and their slots.
+    pub pairs: Pairs,
+    /// Creases with a fold-angle constraint (the driven ones are set by the task).
+    pub creases: Vec<usize>,
+    /// Settings.
+    pub spec: RobustSpec,
+    values: Compiled,
+    pullback: Compiled,
+    n_vertices: usize,
+    n_internal: usize,
+    t_max: f64,
+    /// Milliseconds from the start of the build to native code.
+    pub total_ms: f64,
+}
+
+impl RobustModel {
+    /// Build and compile the block of `model`.
+    pub fn new(model: &Model, spec: RobustSpec) -> Result<RobustModel, compile::CompileError> {
+        let start = Instant::now();
+        let plan = &model.plan;
+        // The two arms of a gripper meet at its target: their tips touch there by design.
+        let tip = (spec.second_arm
+            && model
+                .targets
+                .iter()
+                .any(|t| t.point[0].abs() < 1e-9 && t.point[1].abs() < 1e-9))
+        .then_some(model.gripping);
+        let pairs = Pairs::new(plan, spec.second_arm, tip, &spec.cylinders);
+        let creases: Vec<usize> = (0..plan.creases.len())
+            .filter(|&c| plan.creases[c].drive.is_none())
+            .collect();
+        let (nv, ni, nf, nc) = (
+            plan.vertices.len(),
+            plan.internal.len(),
+            model.free.len(),
+            creases.len(),
+        );
+        let ctx = Ctx::new();
+        let free: Vec<Sym> = (0..nf).map(|k| ctx.var(k)).collect();
+        let vars = model.full_vars(&free);
+        let modes: Vec<Sym> = (0..ni).map(|i| ctx.param(i)).collect();
+        let t = ctx.param(ni);
+        let flat = geometry::flat(plan, &vars);
+        let folded = geometry::fold(plan, &flat, &modes, &t);
+        let x: Vec<[Sym; 3]> = (0..nv)
+            .map(|v| geometry::position(plan, &flat, &folded, v))
+            .collect();
+        let m: Vec<Sym> = plan
+            .internal
+            .iter()
+            .flat_map(|&a| {
+                folded.states[a]
+                    .as_ref()
+                    .expect("internal vertices are solved")
+                    .margins
+                    .clone()
+            })
+            .collect();
+        let rho: Vec<Sym> = creases.iter().map(|&c| folded.rho[c].clone()).collect();
+        let mut value_ids = Vec::with_capacity(3 * nv + 3 * ni + nc);
+        for p in &x {
+            value_ids.extend(p.iter().map(|s| ctx.node_id(s)));
+        }
+        value_ids.extend(m.iter().chain(&rho).map(|s| ctx.node_id(s)));
+        let mut p = ni + 1;
+        let mut s = Sym::from_f64(0.0);
+        for e in x.iter().flatten().chain(&m).chain(&rho) {
+            s = s + ctx.param(p) * e.clone();
+            p += 1;
+        }
+        let s_id = ctx.node_id(&s);
+        let graph = ctx.to_graph();
+        let n_params = p;
+        let base = Options {
+            ..Options::default()
+        };
+        let values = compile::compile(
+            &graph,
+            &value_ids,
+            nf,
+            n_params,
+            &Options {
+                gradients: false,
+                ..base.clone()
+            },
+        )?;
+        let pullback = compile::compile(&graph, &[s_id], nf, n_params, &base)?;
+        Ok(RobustModel {
+            pairs,
+            creases,
+            spec,
+            values,
+            pullback,
+            n_vertices: nv,
+            n_internal: ni,
+            t_max: model.t_max,
+            total_ms: start.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+
+    /// Number of constraint slots per state: the pairs', then one per crease, then three
+    /// margins per internal vertex.
+    pub fn slots(&self) -> usize {
+        self.pairs.slots + self.creases.len() + 3 * self.n_internal
+    }
+
+    /// Number of pullback weights (3 per vertex, 3 per internal vertex, 1 per crease).
+    pub fn n_weights(&self) -> usize {
+        3 * self.n_vertices + 3 * self.n_internal + self.creases.len()
+    }
+
+    /// Sizes and times of the two compiled functions (values, pullback).
+    pub fn reports(&self) -> [&compile::CompileReport; 2] {
+        [&self.values.report, &self.pullback.report]
+    }
+
+    /// Buffers sized for this block.
+    pub fn work(&self) -> Work {
+        Work {
+            params: vec![0.0; self.n_internal + 1 + self.n_weights()],
+            out: vec![0.0; self.values.layout.len().max(self.pullback.layout.len())],
+            weights: vec![0.0; self.n_weights()],
+            ..Work::default()
+        }
+    }
+
+    /// Evaluate the values at `t` (compiled) into `work.values`.
+    pub fn eval(&self, free: &[f64], modes: &[f64], t: f64, work: &mut Work) {
+        let ni = self.n_internal;
+        work.params[..ni].copy_from_slice(modes);
+        work.params[ni] = t;
+        let len = self.values.layout.len();
+        self.values
+            .function
+            .call(free, &work.params, &mut work.out[..len])
+            .expect("buffer sizes match the compiled layout");
+        let nv = self.n_vertices;
+        work.x.clear();
+        work.x
+            .extend((0..nv).map(|v| [work.out[3 * v], work.out[3 * v + 1], work.out[3 * v + 2]]));
+        work.values.scene.set(&work.x, &self.pairs);
+        let (m0, r0) = (3 * nv, 3 * nv + 3 * ni);
+        work.values.margins.clear();
+        work.values.margins.extend_from_slice(&work.out[m0..r0]);
+        work.values.rho.clear();
+        work.values
+            .rho
+            .extend_from_slice(&work.out[r0..r0 + self.creases.len()]);
+    }
+
+    /// The same values from the plain f64 kinematics (no compiled code).
+    pub fn eval_f64(&self, model: &Model, free: &[f64], modes: &[f64], t: f64) -> StateValues {
+        let plan = &model.plan;
+        let vars = model.full_vars(free);
+        let flat = geometry::flat(plan, &vars);
+        let folded = geometry::fold(plan, &flat, modes, &t);
+        let x: Vec<V3> = (0..plan.vertices.len())
+            .map(|v| geometry::position(plan, &flat, &folded, v))
+            .collect();
+        let mut scene = Scene::default();
+        scene.set(&x, &self.pairs);
+        StateValues {
+            scene,
+            margins: plan
+                .internal
+                .iter()
+                .flat_map(|&a| folded.states[a].as_ref().expect("solved").margins)
+                .collect(),
+            rho: self.creases.iter().map(|&c| folded.rho[c]).collect(),
+        }
+    }
+
+    /// Add `∇_free S` for `weights` (on positions, margins, fold angles; see
+    /// [`RobustModel::add_weights`]) at `t` into `grad`: the pullback of those weights
+    /// through the compiled kinematics.
+    pub fn pullback(
+        &self,
+        free: &[f64],
+        modes: &[f64],
+        t: f64,
+        weights: &[f64],
+        work: &mut Work,
+        grad: &mut [f64],
+    ) {
+        let ni = self.n_internal;
+        work.params[..ni].copy_from_slice(modes);
+        work.params[ni] = t;
+        work.params[ni + 1..].copy_from_slice(weights);
+        let len = self.pullback.layout.len();
+        self.pullback
+            .function
+            .call(free, &work.params, &mut work.out[..len])
+            .expect("buffer sizes match the compiled layout");
+        for (g, d) in grad
+            .iter_mut()
+            .zip(&work.out[self.pullback.layout.gradient(0)])
+        {
+            *g += d;
+        }
+    }
+
+    /// The gap each pair must keep at `level` (paper units).
+    pub fn gap(&self, pair: &Pair, level: Level) -> f64 {
+        let s = &self.spec.settings;
+        let k = level.factor();
+        let floor = match level {
+            Level::Setting => 0.0,
+            _ => CLEARANCE_FLOOR,
+        };
+        match pair.kind {
+            PairKind::Obstacle { k: c } => {
+                self.spec.cylinders[c].radius + s.obstacle_clearance * k + floor
+            }
+            _ => s.clearance * k + floor,
+        }
+    }
+
+    /// The fold-angle distance from ±π every crease keeps at `level` (rad).
+    pub fn crease_gap(&self, level: Level) -> f64 {
+        let s = &self.spec.settings;
+        let floor = match level {
+            Level::Setting => 0.0,
+            _ => CLEARANCE_FLOOR,
+        };
+        2.0 * ((s.clearance * level.factor()).min(2.0) / 2.0).asin() + floor
+    }
+
+    /// The margin every vertex keeps at `t` (rad), `None` at the flat state.
+    pub fn margin_required(&self, t: f64, level: Level) -> Option<f64> {
+        if t == 0.0 {
+            return None;
+        }
+        let base = match level {
+            Level::Setting => self.spec.settings.rigid_margin,
+            _ => self.spec.settings.rigid_margin.max(RIGID_MARGIN) * level.factor(),
+        };
+        Some(base * (t / self.t_max).powi(2))
+    }
+
+    /// Visit every constraint at one state: the pairs with a plane (`planes[p]`), then
+    /// every crease and margin constraint: `visit(slot, group, h, dep)`.
+    pub fn visit(
+        &self,
+        t: f64,
+        v: &StateValues,
+        planes: &[Option<Plane>],
+        level: Level,
+        mut visit: impl FnMut(usize, Option<Group>, f64, Dep<'_>),
+    ) {
+        for (p, pair) in self.pairs.pairs.iter().enumerate() {
+            if let Some(plane) = &planes[p] {
+                self.visit_pair(p, plane, v, level, |c| {
+                    visit(c.slot, Some(pair.group), c.h, Dep::X(c.dx))
+                });
+            }
+        }
+        self.visit_rest(t, v, level, |slot, h, dep| visit(slot, None, h, dep));
+    }
+
+    /// Visit the constraints of pair `p` with `plane`.
+    pub fn visit_pair(
+        &self,
+        p: usize,
+        plane: &Plane,
+        v: &StateValues,
+        level: Level,
+        visit: impl FnMut(clearance::Slot<'_>),
+    ) {
+        let pair = &self.pairs.pairs[p];
+        let gap = self.gap(pair, level);
+        clearance::constraints(pair, plane, gap, &v.scene, &self.pairs.cylinders, visit);
+    }
+
+    /// Visit the crease and margin constraints: `visit(slot, h, dep)`.
+    pub fn visit_rest(
+        &self,
+        t: f64,
+        v: &StateValues,
+        level: Level,
+        mut visit: impl FnMut(usize, f64, Dep<'_>),
+    ) {
+        let base = self.pairs.slots;
+        let lim = PI - self.crease_gap(level);
+        for (c, rho) in v.rho.iter().enumerate() {
+            let w = wrap_angle(*rho);
+            visit(base + c, lim - w.abs(), Dep::Rho(c, -w.signum()));
+        }
+        if let Some(req) = self.margin_required(t, level) {
+            let base = base + self.creases.len();
+            for (k, m) in v.margins.iter().enumerate() {
+                visit(base + k, m - req, Dep::Margin(k));
+            }
+        }
+    }
+
+    /// Fit the planes of one state into `planes`: pairs within reach get a plane (refitted
+    /// from the previous one), far ones none unless `keep(p)` (they carry a multiplier).
+    pub fn fit(
+        &self,
+        v: &StateValues,
+        planes: &mut [Option<Plane>],
+        keep: impl Fn(usize) -> bool,
+        level: Level,
+        effort: Effort,
+        buffers: &mut Buffers,
+    ) {
+        for (p, pair) in self.pairs.pairs.iter().enumerate() {
+            let need = match pair.kind {
+                PairKind::Cone { .. } => 2.0 * (self.gap(pair, level).min(2.0) / 2.0).asin(),
+                _ => self.gap(pair, level),
+            };
+            if !keep(p) && self.pairs.lower_bound(pair, &v.scene, buffers) > need + ACTIVATE {
+                planes[p] = None;
+                continue;
+            }
+            // A previous plane that still shows the gap with room to spare is kept: the
+            // pair is inactive and where its plane sits does not matter.
+            let enough = match pair.kind {
+                PairKind::Cone { .. } => (self.gap(pair, level).min(2.0) / 2.0) + effort.enough,
+                PairKind::Obstacle { .. } => need + effort.enough,
+                PairKind::Apart => need + effort.enough,
+            };
+            let (plane, _) = clearance::fit_plane(
+                pair,
+                &v.scene,
+                &self.pairs.cylinders,
+                planes[p],
+                self.gap(pair, level),
+                Effort { enough, ..effort },
+                buffers,
+            );
+            planes[p] = Some(plane);
+        }
+    }
+
+    /// Add `coeff · ∂h/∂(values)` of one constraint into the pullback weights.
+    pub fn add_weights(&self, dep: Dep<'_>, coeff: f64, w: &mut [f64]) {
+        match dep {
+            Dep::X(gs) => {
+                for (r, g) in gs {
+                    // The copy is the arm turned by 180° about z: ∂/∂X = R ∂/∂(R X), R = Rᵀ.
+                    let g = if r.copy {
+                        clearance::copy_point(*g)
+                    } else {
+                        *g
+                    };
+                    for i in 0..3 {
+                        w[3 * r.vertex + i] += coeff * g[i];
+                    }
+                }
+            }
+            Dep::Margin(k) => w[3 * self.n_vertices + k] += coeff,
+            Dep::Rho(c, d) => w[3 * self.n_vertices + 3 * self.n_internal + c] += coeff * d,
+        }
+    }
+}
+
+/// One sampled state of a start: its t, planes, multipliers, and whether it is live.
+#[derive(Clone, Debug)]
+struct SampledState {
+    t: f64,
+    planes: Vec<Option<Plane>>,
+    lambda: Vec<f64>,
+    /// Pairs near their bound or with a multiplier: the ones the merit visits.
+    active: Vec<bool>,
+    live: bool,
+}
+
+/// The block of one alternative (a model, its modes): a [`Robust`] for the optimizer.
+pub struct RobustProblem<'a> {
+    model: &'a Model,
+    block: &'a RobustModel,
+    modes: Vec<f64>,
+    states: RefCell<Vec<SampledState>>,
+    /// The planes that are variables of the current subproblem: (state, pair, offset).
+    layout: RefCell<Vec<(usize, usize, usize)>>,
+    work: RefCell<Work>,
+}
+
+impl<'a> RobustProblem<'a> {
+    /// The block of `model` with the given modes.
+    pub fn new(model: &'a Model, block: &'a RobustModel, modes: &[f64]) -> RobustProblem<'a> {
+        let p = RobustProblem {
+            model,
+            block,
+            modes: modes.to_vec(),
+            states: RefCell::new(Vec::new()),
+            layout: RefCell::new(Vec::new()),
+            work: RefCell::new(block.work()),
+        };
+        p.reset();
+        p
+    }
+
+    fn new_state(&self, t: f64) -> SampledState {
+        SampledState {
+            t,
+            planes: vec![None; self.block.pairs.pairs.len()],
+            lambda: vec![0.0; self.block.slots()],
+            active: vec![false; self.block.pairs.pairs.len()],
+            live: true,
+        }
+    }
+
+    /// Set every multiplier to `lambda` (to examine the merit where every term is smooth:
+    /// with `λ > μ h` for all constraints, no `max(0, ·)` switches). The flat state t = 0
+    /// leaves the merit: its fold angles are 0, where `|ρ|` switches, and its vertex
+    /// triangles are degenerate.
+    pub fn set_multipliers(&self, lambda: f64) {
+        for st in self.states.borrow_mut().iter_mut() {
+            st.lambda.iter_mut().for_each(|l| *l = lambda);
+            st.active.iter_mut().for_each(|a| *a = true);
+            st.live = st.t > 0.0;
+        }
+    }
+
+    /// The planes that are variables of the current subproblem (after
+    /// [`Robust::variables`]): the state's t and the pair, in the order of the variables.
+    pub fn variable_planes(&self) -> Vec<(f64, Pair)> {
+        let states = self.states.borrow();
+        self.layout
+            .borrow()
+            .iter()
+            .map(|&(si, p, _)| (states[si].t, self.block.pairs.pairs[p].clone()))
+            .collect()
+    }
+
+    /// The t of every sampled state (the evenly spaced ones, then those added).
+    pub fn sampled_times(&self) -> Vec<f64> {
+        self.states.borrow().iter().map(|s| s.t).collect()
+    }
+
+    /// Fit a state's planes at the values in `work` and measure it: returns its largest
+    /// violation and whether a constraint is near its bound or carries a multiplier.
+    fn refit(&self, st: &mut SampledState, work: &mut Work) -> (f64, bool) {
+        let b = self.block;
+        let lambda = &st.lambda;
+        let pairs = &b.pairs.pairs;
+        b.fit(
+            &work.values,
+            &mut st.planes,
+            |p| {
+                let r = pairs[p].slot..pairs[p].slot + pairs[p].slots();
+                lambda[r].iter().any(|l| *l > 0.0)
+            },
+            Level::Imposed,
+            FIT,
+            &mut work.buffers,
+        );
+        let mut worst = 0.0_f64;
+        let mut live = false;
+        let mut near = vec![false; b.slots()];
+        b.visit(
+            st.t,
+            &work.values,
+            &st.planes,
+            Level::Imposed,
+            |slot, _, h, _| {
+                worst = worst.max(-h);
+                near[slot] = h < LIVE || lambda[slot] > 0.0;
+                live |= near[slot];
+            },
+        );
+        for (p, pair) in pairs.iter().enumerate() {
+            st.active[p] = near[pair.slot..pair.slot + pair.slots()].iter().any(|x| *x);
+        }
+        (worst, live)
+    }
+}
+
+impl Robust for RobustProblem<'_> {
+    fn reset(&self) {
+        let n = self.block.spec.states.max(2);
+        *self.states.borrow_mut() = (0..n)
+            .map(|i| self.new_state(self.model.t_max * i as f64 / (n - 1) as f64))
+            .collect();
+    }
+
+    fn update(&self, x: &[f64], mu: Option<f64>) -> f64 {
+        let b = self.block;
+        let mut states = self.states.borrow_mut();
+        let mut work = self.work.borrow_mut();
+        let mut worst = 0.0_f64;
+        for st in states.iter_mut() {
+            b.eval(x, &self.modes, st.t, &mut work);
+            if let Some(mu) = mu {
+                let lambda = &mut st.lambda;
+                b.visit(
+                    st.t,
+                    &work.values,
+                    &st.planes,
+                    Level::Imposed,
+                    |slot, _, h, _| {
+                        lambda[slot] = (lambda[slot] - mu * h).max(0.0);
+                    },
+                );
+            }
+            let (w, live) = self.refit(st, &mut work);
+            worst = worst.max(w);
+            st.live = live;
+        }
+        worst
+    }
+
+    fn variables(&self) -> Vec<f64> {
+        let states = self.states.borrow();
+        let mut layout = self.layout.borrow_mut();
+        layout.clear();
+        let mut z = Vec::new();
+        for (si, st) in states.iter().enumerate().filter(|(_, s)| s.live) {
+            for (p, plane) in st.planes.iter().enumerate() {
+                let Some(plane) = plane else { continue };
+                if !st.active[p] {
+                    continue;
+                }
+                layout.push((si, p, z.len()));
+                z.extend_from_slice(&plane.n);
+                if self.block.pairs.pairs[p].has_offset() {
+                    z.push(plane.d);
+                }
+            }
+        }
+        z
+    }
+
+    fn set_variables(&self, z: &[f64]) {
+        let mut states = self.states.borrow_mut();
+        for &(si, p, o) in self.layout.borrow().iter() {
+            let v = [z[o], z[o + 1], z[o + 2]];
+            let len = crate::geom::norm(v);
+            if len > 0.0 && len.is_finite() {
+                let d = if self.block.pairs.pairs[p].has_offset() {
+                    z[o + 3]
+                } else {
+                    0.0
+                };
+                states[si].planes[p] = Some(Plane {
+                    n: crate::geom::scale(v, 1.0 / len),
+                    d,
+                });
+            }
+        }
+    }
+
+    fn merit(&self, x: &[f64], z: &[f64], mu: f64, grad_x: &mut [f64], grad_z: &mut [f64]) -> f64 {
+        let b = self.block;
+        let states = self.states.borrow();
+        let layout = self.layout.borrow();
+        let mut work = self.work.borrow_mut();
+        let mut value = 0.0;
+        let mut next = 0;
+        for (si, st) in states.iter().enumerate().filter(|(_, s)| s.live) {
+            b.eval(x, &self.modes, st.t, &mut work);
+            let Work {
+                values, weights, ..
+            } = &mut *work;
+            weights.iter_mut().for_each(|w| *w = 0.0);
+            let mut any = false;
+            let mut term = |slot: usize, h: f64| {
+                let l = st.lambda[slot];
+                let a = (l - mu * h).max(0.0);
+                value += (a * a - l * l) / (2.0 * mu);
+                a
+            };
+            while next < layout.len() && layout[next].0 == si {
+                let (_, p, o) = layout[next];
+                next += 1;
+                let v = [z[o], z[o + 1], z[o + 2]];
+                let len = crate::geom::norm(v).max(1e-300);
+                let n = crate::geom::scale(v, 1.0 / len);
+                let has_d = b.pairs.pairs[p].has_offset();
+                let plane = Plane {
+                    n,
+                    d: if has_d { z[o + 3] } else { 0.0 },
+                };
+                b.visit_pair(p, &plane, values, Level::Imposed, |c| {
+                    let a = term(c.slot, c.h);
+                    if a > 0.0 {
+                        b.add_weights(Dep::X(c.dx), -a, weights);
+                        any = true;
+                        // ∂n/∂v = (I − n nᵀ)/|v|.
+                        let dn_n = crate::geom::dot(c.dn, n);
+                        for i in 0..3 {
+                            grad_z[o + i] -= a * (c.dn[i] - dn_n * n[i]) / len;
+                        }
+                        if has_d {
+                            grad_z[o + 3] -= a * c.dd;
+                        }
+                    }
+                });
+            }
+            b.visit_rest(st.t, values, Level::Imposed, |slot, h, dep| {
+                let a = term(slot, h);
+                if a > 0.0 {
+                    b.add_weights(dep, -a, weights);
+                    any = true;
+                }
+            });
+            if any {
+                let w = std::mem::take(&mut work.weights);
+                b.pullback(x, &self.modes, st.t, &w, &mut work, grad_x);
+                work.weights = w;
+            }
+        }
+        value
+    }
+
+    fn accept(&self, x: &[f64]) -> Acceptance {
+        let b = self.block;
+        let n = b.spec.sweep;
+        let np = b.pairs.pairs.len();
+        let mut work = self.work.borrow_mut();
+        let mut planes: Vec<Option<Plane>> = vec![None; np];
+        let mut worst: Vec<(f64, f64)> = Vec::new();
+        let mut unwrapped: Option<Vec<f64>> = None;
+        let lim = PI - b.crease_gap(Level::Accept);
+        for i in 0..n {
+            let t = self.model.t_max * i as f64 / (n - 1) as f64;
+            b.eval(x, &self.modes, t, &mut work);
+            // Fold angles followed continuously from the flat state: one passing ±π between
+            // two sweep states has flipped a facet through its neighbour.
+            let next: Vec<f64> = match &unwrapped {
+                None => work.values.rho.iter().map(|r| wrap_angle(*r)).collect(),
+                Some(prev) => prev
+                    .iter()
+                    .zip(&work.values.rho)
+                    .map(|(p, r)| p + wrap_angle(r - p))
+                    .collect(),
+            };
+            if next.iter().any(|r| r.abs() > lim) {
+                return Acceptance::Rejected;
+            }
+            unwrapped = Some(next);
+            // Planes carry over from the previous sweep state as a warm start.
+            let Work {
+                values, buffers, ..
+            } = &mut *work;
+            b.fit(
+                values,
+                &mut planes,
+                |_| false,
+                Level::Accept,
+                SWEEP_FIT,
+                buffers,
+            );
+            let mut h_min = f64::INFINITY;
+            b.visit(t, values, &planes, Level::Accept, |_, _, h, _| {
+                h_min = h_min.min(h);
+            });
+            if h_min < -1e-12 {
+                worst.push((h_min, t));
+            }
+        }
+        if worst.is_empty() {
+            return Acceptance::Accepted;
+        }
+        let mut states = self.states.borrow_mut();
+        let added = states.len().saturating_sub(b.spec.states.max(2));
+        worst.sort_by(|p, q| p.0.total_cmp(&q.0));
+        let mut new = 0;
+        for (_, t) in worst {
+            if new == 4 || added + new >= MAX_ADDED_STATES {
+                break;
+            }
+            if states.iter().any(|s| (s.t - t).abs() < 1e-12) {
+                continue;
+            }
+            let mut st = self.new_state(t);
+            b.eval(x, &self.modes, t, &mut work);
+            let (_, live) = self.refit(&mut st, &mut work);
+            st.live = live;
+            states.push(st);
+            new += 1;
+        }
+        if new == 0 {
+            Acceptance::Rejected
+        } else {
+            Acceptance::Refined
+        }
+    }
+}
