@@ -1099,25 +1099,10 @@ fn write_designs(
     out_dir.create_dir("designs")?;
     // Designs are independent: built and written in parallel, a chunk at a time (memory
     // holds one chunk); each chunk's files are listed in the manifest in one step before
-    // any is written. The cards stay in record order.
-    let build = |rec: &AlternativeRecord| -> Result<DesignWork, SearchError> {
-        let model = Model::new(&plan.graph(task, rec.graph), task, rec.candidate - 1)?;
-        let free: Vec<f64> = model
-            .free
-            .iter()
-            .map(|&i| {
-                rec.variables
-                    .get(&model.plan.variables[i].name)
-                    .copied()
-                    .unwrap_or(model.var_bounds(i).0)
-            })
-            .collect();
-        let full = model.full_vars(&free);
-        let modes: Vec<f64> = rec
-            .modes
-            .iter()
-            .map(|m| if m == "up" { 1.0 } else { -1.0 })
-            .collect();
+    // any is written. The cards stay in the order of `feasible`: most robust first, `rank`
+    // 1.
+    let build = |(rank, rec): (usize, &AlternativeRecord)| -> Result<DesignWork, SearchError> {
+        let (model, free, full, modes) = design_of(task, &plan.graph(task, rec.graph), rec)?;
         let design = Evaluated::new(&model.plan, full.clone(), modes);
         let pattern = design.pattern(&sample_times(model.t_max, 33));
         let meta = design_meta(task, &model, rec);
@@ -1153,8 +1138,11 @@ fn write_designs(
             "verification": rec.verification,
             "self_intersection_free": rec.self_intersection_free,
             "obstacle_free": rec.obstacle_free,
+            "robustness": rec.robustness,
+            "rank": rank,
             "pattern": pattern,
             "meta": meta,
+            "svg": export::svg::svg_scale(&pattern, &Default::default()).ok(),
         });
         Ok(DesignWork {
             rec: rec.clone(),
@@ -1221,9 +1209,14 @@ fn write_designs(
         Some(feasible.len() as u64),
     );
     let mut cards: Vec<export::report::ReportDesign> = Vec::new();
-    for chunk in feasible.chunks(256) {
+    for (c, chunk) in feasible.chunks(256).enumerate() {
         let recs = read_at(records, chunk)?;
-        let work = pool.install(|| recs.par_iter().map(build).collect::<Result<Vec<_>, _>>())?;
+        let work = pool.install(|| {
+            recs.par_iter()
+                .enumerate()
+                .map(|(k, rec)| build((c * 256 + k + 1, rec)))
+                .collect::<Result<Vec<_>, _>>()
+        })?;
         // Listed before they are written, so a kill leaves nothing unlisted.
         let mut files: Vec<PathBuf> = work
             .iter()
