@@ -1,8 +1,8 @@
 //! foldsynth: synthesis of rigidly foldable origami crease patterns.
 //!
 //! The data flows one way (see `ARCHITECTURE.md`):
-//! task → grammar → model → compile → optimize → check → search → export,
-//! with [`kinematics`] (the Principle of Three Units, generic over [`kinematics::Scalar`])
+//! task → grammar → model → compile → optimize → check → search → export, with
+//! [`distribute`] (shards, merge, Slurm) above `search`, [`kinematics`] (the Principle of Three Units, generic over [`kinematics::Scalar`])
 //! and [`expr`] (the expression graph) underneath, and [`simulate`] as the numeric
 //! bar-and-hinge baseline of thesis Sec. 3.
 
@@ -12,6 +12,7 @@ pub mod check;
 pub mod cli;
 pub mod compile;
 pub mod cpu_time;
+pub mod distribute;
 pub mod export;
 pub mod expr;
 pub mod fuzz;

@@ -6,17 +6,11 @@
 //! lists them.
 
 /// Largest N_max (task files and `--n-max`). The graphs grow about twentyfold per
-/// internal vertex; whether a given task fits at a given N_max is estimated before the
-/// enumeration ([`GRAPHS_MAX`]).
+/// internal vertex; enumeration and search stream them (memory does not grow with N_max),
+/// but time does: N_max = 5 is a cluster's job (`foldsynth slurm`), 6 a large cluster's.
 pub const N_MAX: usize = 6;
-/// Most graphs one enumeration keeps in memory (about [`GRAPH_BYTES`] each: 1.5 GB).
-pub const GRAPHS_MAX: usize = 100_000;
-/// Memory per generated graph, measured: the gripper at N_max = 5 keeps 41,549 graphs in
-/// a peak of 622 MB.
-pub const GRAPH_BYTES: u64 = 15_000;
-/// Most design alternatives one search evaluates (graphs × 2^N × 3 candidates; the
-/// gripper has 1,194 at N_max = 3, 28,122 at 4, 711,642 at 5).
-pub const ALTERNATIVES_MAX: u64 = 1_000_000;
+/// Most shards of one search (`--shard K/N`, `slurm --shards N`).
+pub const SHARDS_MAX: usize = 100_000;
 /// Most starting points per alternative (`--starts`).
 pub const STARTS_MAX: usize = 1_000;
 /// Most states of the verification sweep (`--sweep`, `model --sweep`).

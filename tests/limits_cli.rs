@@ -102,43 +102,6 @@ fn every_count_has_a_limit() {
 }
 
 #[test]
-fn a_large_n_max_is_refused_with_its_estimated_size() {
-    // n_max = 6 is inside the task file's range, but its graphs do not fit in memory: a
-    // refusal with the estimate (not "memory allocation failed"), and no advice to switch
-    // on a filter that is on.
-    let err = refused(
-        &["enumerate", GRIPPER, "--n-max", "6"],
-        &["N_max = 6", "graphs", "GB", "lower N_max to 5"],
-    );
-    assert!(!err.contains("isomorphism"), "{err}");
-    let err = refused(
-        &["enumerate", GRIPPER, "--n-max", "5", "--no-iso"],
-        &["N_max = 5", "drop --no-iso"],
-    );
-    assert!(err.contains("lower N_max to"), "{err}");
-    let dir = tempfile::tempdir().unwrap();
-    let task = dir.path().join("six.toml");
-    std::fs::write(
-        &task,
-        std::fs::read_to_string(GRIPPER)
-            .unwrap()
-            .replace("n_max = 3", "n_max = 6"),
-    )
-    .unwrap();
-    let out = dir.path().join("o");
-    refused(
-        &[
-            "synthesize",
-            task.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ],
-        &["N_max = 6 is too large", "lower N_max to 5"],
-    );
-    assert!(!out.exists());
-}
-
-#[test]
 fn echoes_are_cut_and_os_errors_said_once() {
     // A 309-digit number and a 100 KB input are not echoed back whole.
     let huge = format!("1{}", "0".repeat(308));

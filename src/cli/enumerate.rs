@@ -3,11 +3,15 @@
 
 use std::path::PathBuf;
 
+use std::io::{BufWriter, Write};
+
 use anyhow::Context;
 use serde::Serialize;
 
-use crate::grammar::{Enumeration, Filters, Rules, Status};
-use crate::limits::{GRAPHS_MAX, N_MAX};
+use crate::grammar::{
+    DOT_FOOTER, Enumeration, Filters, LevelCounts, Rules, Status, dot_header, dot_node,
+};
+use crate::limits::N_MAX;
 use crate::task::Task;
 
 /// Output format.
@@ -48,13 +52,6 @@ pub struct EnumerateArgs {
 }
 
 #[derive(Serialize)]
-struct Filtered {
-    isomorphic: usize,
-    mirror: usize,
-    invalid: usize,
-}
-
-#[derive(Serialize)]
 struct GraphEntry {
     sequence: String,
     level: usize,
@@ -69,41 +66,23 @@ struct GraphEntry {
     cyclic: Option<bool>,
 }
 
-#[derive(Serialize)]
-struct Report {
-    #[serde(skip_serializing_if = "Option::is_none")]
-    rules: Option<String>,
-    generated: usize,
-    filtered: Filtered,
+/// One meaningful graph for the text report.
+struct Meaningful {
+    sequence: String,
+    n: usize,
     alternatives: u64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    cyclic: Option<CyclicSummary>,
-    graphs: Vec<GraphEntry>,
 }
 
 /// With r2′: the cyclic share of the language.
-#[derive(Serialize)]
+#[derive(Default, Serialize)]
 struct CyclicSummary {
     generated: usize,
     meaningful: usize,
     alternatives: u64,
 }
 
-fn cyclic_summary(e: &Enumeration) -> Option<CyclicSummary> {
-    e.rules.r2p.then(|| {
-        let cyc = || e.nodes.iter().filter(|n| n.graph.is_cyclic_pattern());
-        CyclicSummary {
-            generated: cyc().count(),
-            meaningful: cyc().filter(|n| n.status == Status::Meaningful).count(),
-            alternatives: cyc()
-                .filter(|n| n.status == Status::Meaningful)
-                .map(|n| n.graph.alternatives())
-                .sum(),
-        }
-    })
-}
-
-/// Run `foldsynth enumerate`.
+/// Run `foldsynth enumerate`. The graphs stream: each is written (JSON, DOT) or counted
+/// as it is generated and then dropped, so N_max = 5 and 6 run in bounded memory.
 pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
     let task = Task::load(&args.task)?;
     let n_max = args.n_max.unwrap_or(task.n_max);
@@ -112,48 +91,120 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
         mirror: !args.no_mirror,
         validity: !args.no_validity,
     };
-    // Every generated graph is kept (about 15 kB each): what does not fit the budget is
-    // refused with its estimated size, before memory runs out.
-    let e = Enumeration::run_within_with(&task, n_max, filters, args.rules, GRAPHS_MAX)
-        .map_err(|est| anyhow::anyhow!("{}", est.refusal(&task.name, n_max, filters)))?;
-    if let Some(path) = &args.tree {
-        std::fs::write(path, e.to_dot())
+    let mut dot = match &args.tree {
+        Some(path) => {
+            let f = std::fs::File::create(path)
+                .with_context(|| format!("cannot write the search tree to {}", path.display()))?;
+            let mut w = BufWriter::new(f);
+            w.write_all(dot_header(n_max).as_bytes())?;
+            Some((path, w))
+        }
+        None => None,
+    };
+    let json = args.format == Format::Json;
+    let mut out = BufWriter::new(std::io::stdout().lock());
+    if json {
+        // The graphs first (streamed), the totals after them.
+        out.write_all(b"{\n  \"graphs\": [")?;
+    }
+    let mut levels: Vec<LevelCounts> = Vec::new();
+    let mut meaningful: Vec<Meaningful> = Vec::new();
+    let mut alternatives = 0u64;
+    let mut failed: Option<std::io::Error> = None;
+    let rules = args.rules;
+    let mut cyclic = CyclicSummary::default();
+    let streamed = Enumeration::stream_with(&task, n_max, filters, rules, |g| {
+        LevelCounts::count(&mut levels, g.level, g.status);
+        let alt = if g.status == Status::Meaningful {
+            g.graph.alternatives()
+        } else {
+            0
+        };
+        alternatives += alt;
+        let is_cyclic = rules.r2p && g.graph.is_cyclic_pattern();
+        if is_cyclic {
+            cyclic.generated += 1;
+            cyclic.meaningful += usize::from(g.status == Status::Meaningful);
+            cyclic.alternatives += alt;
+        }
+        if failed.is_some() {
+            return;
+        }
+        let written = (|| -> std::io::Result<()> {
+            if let Some((_, w)) = &mut dot {
+                w.write_all(dot_node(&g).as_bytes())?;
+            }
+            if json {
+                let entry = GraphEntry {
+                    sequence: g.graph.sequence(),
+                    level: g.level,
+                    internal_vertices: g.graph.internal_count(),
+                    status: g.status,
+                    parent: g.parent,
+                    alternatives: alt,
+                    cyclic: rules.r2p.then_some(is_cyclic),
+                };
+                let sep = if g.index == 0 { "" } else { "," };
+                write!(out, "{sep}\n    {}", serde_json::to_string(&entry)?)?;
+            } else if g.status == Status::Meaningful {
+                meaningful.push(Meaningful {
+                    sequence: g.graph.sequence(),
+                    n: g.graph.internal_count(),
+                    alternatives: alt,
+                });
+            }
+            Ok(())
+        })();
+        if let Err(e) = written {
+            failed = Some(e);
+        }
+    });
+    if let Some(e) = failed {
+        return Err(e).context("cannot write the enumeration");
+    }
+    if let Some((path, mut w)) = dot {
+        w.write_all(DOT_FOOTER.as_bytes())
+            .and_then(|_| w.flush())
             .with_context(|| format!("cannot write the search tree to {}", path.display()))?;
     }
-    match args.format {
-        Format::Json => {
-            let report = Report {
-                rules: e.rules.r2p.then(|| e.rules.names()),
-                cyclic: cyclic_summary(&e),
-                generated: e.nodes.len(),
-                filtered: Filtered {
-                    isomorphic: e.count(Status::Isomorphic),
-                    mirror: e.count(Status::Mirror),
-                    invalid: e.count(Status::Invalid),
-                },
-                alternatives: e.alternatives(),
-                graphs: e
-                    .nodes
-                    .iter()
-                    .map(|n| GraphEntry {
-                        sequence: n.graph.sequence(),
-                        level: n.level,
-                        internal_vertices: n.graph.internal_count(),
-                        status: n.status,
-                        parent: n.parent,
-                        alternatives: if n.status == Status::Meaningful {
-                            n.graph.alternatives()
-                        } else {
-                            0
-                        },
-                        cyclic: e.rules.r2p.then(|| n.graph.is_cyclic_pattern()),
-                    })
-                    .collect(),
-            };
-            println!("{}", serde_json::to_string_pretty(&report)?);
+    let total = |f: fn(&LevelCounts) -> usize| levels.iter().map(f).sum::<usize>();
+    if json {
+        let mut tail = serde_json::json!({
+            "generated": streamed.generated,
+            "filtered": {
+                "isomorphic": total(|c| c.isomorphic),
+                "mirror": total(|c| c.mirror),
+                "invalid": total(|c| c.invalid),
+            },
+            "alternatives": alternatives,
+        });
+        if rules.r2p {
+            tail["rules"] = serde_json::json!(rules.names());
+            tail["cyclic"] = serde_json::to_value(&cyclic)?;
         }
-        Format::Text => print!("{}", text_report(&task, &e, &args)),
+        let tail = serde_json::to_string_pretty(&tail)?;
+        // The totals' fields, after the graphs, in the same object.
+        let fields = tail
+            .trim()
+            .trim_start_matches('{')
+            .trim_end_matches('}')
+            .trim_end();
+        writeln!(out, "\n  ],{fields}\n}}")?;
+    } else {
+        let report = text_report(
+            &task,
+            &args,
+            n_max,
+            filters,
+            streamed.mirror_applied,
+            &levels,
+            &meaningful,
+            alternatives,
+            rules.r2p.then_some(&cyclic),
+        );
+        out.write_all(report.as_bytes())?;
     }
+    out.flush()?;
     Ok(())
 }
 
@@ -161,7 +212,18 @@ fn on(b: bool) -> &'static str {
     if b { "on" } else { "off" }
 }
 
-fn text_report(task: &Task, e: &Enumeration, args: &EnumerateArgs) -> String {
+#[allow(clippy::too_many_arguments)]
+fn text_report(
+    task: &Task,
+    args: &EnumerateArgs,
+    n_max: usize,
+    filters: Filters,
+    mirror_applied: bool,
+    levels: &[LevelCounts],
+    meaningful: &[Meaningful],
+    alternatives: u64,
+    cyclic: Option<&CyclicSummary>,
+) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let _ = writeln!(
@@ -169,30 +231,30 @@ fn text_report(task: &Task, e: &Enumeration, args: &EnumerateArgs) -> String {
         "task: {} ({}), N_max = {}",
         task.name,
         args.task.display(),
-        e.n_max
+        n_max
     );
-    let mirror = if e.filters.mirror && !e.mirror_applied {
+    let mirror = if filters.mirror && !mirror_applied {
         "off (task not mirror-symmetric)"
     } else {
-        on(e.mirror_applied)
+        on(mirror_applied)
     };
     let _ = writeln!(
         s,
         "filters: isomorphism {}, mirror {}, semantic validity {}",
-        on(e.filters.isomorphism),
+        on(filters.isomorphism),
         mirror,
-        on(e.filters.validity)
+        on(filters.validity)
     );
-    if e.rules != Rules::default() {
-        let _ = writeln!(s, "rules: {}", e.rules.names().replace("r2p", "r2′"));
+    if args.rules != Rules::default() {
+        let _ = writeln!(s, "rules: {}", args.rules.names().replace("r2p", "r2′"));
     }
     let _ = writeln!(s);
     let _ = writeln!(
         s,
         "level  generated  isomorphic  mirror  invalid  meaningful"
     );
-    let mut total = crate::grammar::LevelCounts::default();
-    for c in e.level_counts() {
+    let mut total = LevelCounts::default();
+    for c in levels {
         let _ = writeln!(
             s,
             "{:>5}  {:>9}  {:>10}  {:>6}  {:>7}  {:>10}",
@@ -211,22 +273,19 @@ fn text_report(task: &Task, e: &Enumeration, args: &EnumerateArgs) -> String {
     );
     let _ = writeln!(s);
     let _ = writeln!(s, "meaningful graphs ({}):", total.meaningful);
-    for n in e.meaningful() {
+    for m in meaningful {
         let _ = writeln!(
             s,
             "  {:<28} N = {}  alternatives = {}",
-            n.graph.sequence(),
-            n.graph.internal_count(),
-            n.graph.alternatives()
+            m.sequence, m.n, m.alternatives
         );
     }
     let _ = writeln!(s);
     let _ = writeln!(
         s,
-        "design alternatives: {} (sum over meaningful graphs of 2^N RBM assignments x 3 gripping candidates)",
-        e.alternatives()
+        "design alternatives: {alternatives} (sum over meaningful graphs of 2^N RBM assignments x 3 gripping candidates)"
     );
-    if let Some(c) = cyclic_summary(e) {
+    if let Some(c) = cyclic {
         let _ = writeln!(
             s,
             "cyclic graphs (closed by r2′): {} generated, {} meaningful, {} alternatives",

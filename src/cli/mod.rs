@@ -11,9 +11,11 @@ pub mod enumerate;
 pub mod export;
 pub mod formulas;
 pub mod fuzz;
+pub mod merge;
 pub mod model;
 pub mod optimize_flasher;
 pub mod simulate;
+pub mod slurm;
 pub mod synthesize;
 pub mod verify;
 pub mod vertex;
@@ -32,6 +34,11 @@ pub struct Cli {
 pub enum Command {
     /// Run the whole method on a design task: enumerate, optimize, check, verify, export.
     Synthesize(synthesize::SynthesizeArgs),
+    /// Merge the shard directories of one search into the run one machine would write.
+    Merge(merge::MergeArgs),
+    /// Write (and with --submit, submit) Slurm batch scripts: a job array of shards and a
+    /// merge job after it.
+    Slurm(slurm::SlurmArgs),
     /// The PTU for one vertex: unit, internal, start/end and dihedral angles over t.
     Vertex(vertex::VertexArgs),
     /// Generate every crease pattern graph of a task (rules r1, r2; thesis Table 3).
@@ -94,6 +101,8 @@ pub fn error_text(e: &anyhow::Error) -> String {
 pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Synthesize(a) => synthesize::run(a),
+        Command::Merge(a) => merge::run(a),
+        Command::Slurm(a) => slurm::run(a),
         Command::Vertex(a) => vertex::run(a),
         Command::Enumerate(args) => enumerate::run(args),
         Command::Bench(a) => bench::run(a),

@@ -1,7 +1,9 @@
 //! `foldsynth synthesize TASK [--out DIR] [--jobs N] [--starts K] [--seed S] [--resume]
-//! [--force]`: the whole method on a design task.
+//! [--force] [--shard K/N]`: the whole method on a design task, or one shard of it.
 
+use crate::distribute;
 use crate::limits;
+use crate::search::output::ShardSpec;
 use crate::search::{self, SearchOptions, output};
 use crate::task::Task;
 use anyhow::Result;
@@ -44,6 +46,11 @@ pub struct SynthesizeArgs {
     /// report.html, with its 3D views, are written either way).
     #[arg(long)]
     pub no_export: bool,
+    /// Run only shard K of N (1 ≤ K ≤ N) of the search: a deterministic, cost-balanced
+    /// share of its models, into its own directory (records only; `foldsynth merge` makes
+    /// the whole run of all N). Resumable with --resume like a whole run.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<ShardSpec>,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -60,7 +67,12 @@ pub struct SynthesizeArgs {
 /// Run `foldsynth synthesize`.
 pub fn run(args: SynthesizeArgs) -> Result<()> {
     let task = Task::load(&args.task)?;
-    let out = args.out.unwrap_or_else(|| output::default_dir(&task.name));
+    let out = args.out.unwrap_or_else(|| match args.shard {
+        Some(s) => {
+            output::default_dir(&task.name).join(format!("shard-{}-of-{}", s.index, s.count))
+        }
+        None => output::default_dir(&task.name),
+    });
     let opts = SearchOptions {
         out: out.clone(),
         jobs: args.jobs,
@@ -75,6 +87,35 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         rules: args.rules,
         post_check_only: args.post_check_only,
     };
+    if let Some(spec) = args.shard {
+        // The text the task was read from, kept with the shard for the merge.
+        let text = limits::read_text(&args.task)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", args.task.display()))?;
+        let report = distribute::shard::run(&task, &text, &opts, spec)?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&report)?);
+        } else {
+            println!(
+                "shard {spec} of task {}: {} models, {} alternatives ({:.1}% of the estimated cost), {} records{}",
+                task.name,
+                report.units,
+                report.alternatives,
+                100.0 * report.cost as f64 / report.total_cost.max(1) as f64,
+                report.records,
+                if report.failed_models.is_empty() {
+                    String::new()
+                } else {
+                    format!("; {} models failed", report.failed_models.len())
+                }
+            );
+            println!(
+                "results in {}; merge all {} shards with: foldsynth merge DIR… --out DIR",
+                out.display(),
+                spec.count
+            );
+        }
+        return Ok(());
+    }
     let summary = search::run(&task, &opts)?;
     let files = format!(
         "report: {}\nsummary: {}\n",

@@ -21,7 +21,7 @@ use serde::Serialize;
 
 use super::canon::Code;
 use super::graph::CreaseGraph;
-use super::notation::parse_sequence;
+use super::notation::{Step, parse_sequence};
 use crate::task::Task;
 
 /// Which filters run. Each can be switched off.
@@ -194,6 +194,69 @@ pub struct LevelCounts {
     pub meaningful: usize,
 }
 
+impl LevelCounts {
+    /// Count one graph of `level` with `status` into `levels` (one entry per level from 1,
+    /// grown as needed).
+    pub fn count(levels: &mut Vec<LevelCounts>, level: usize, status: Status) {
+        while levels.len() < level {
+            levels.push(LevelCounts {
+                level: levels.len() + 1,
+                ..LevelCounts::default()
+            });
+        }
+        let c = &mut levels[level - 1];
+        c.generated += 1;
+        match status {
+            Status::Meaningful => c.meaningful += 1,
+            Status::Invalid => c.invalid += 1,
+            Status::Mirror => c.mirror += 1,
+            Status::Isomorphic => c.isomorphic += 1,
+        }
+    }
+}
+
+/// The start of the search tree in Graphviz DOT, up to the first graph.
+pub fn dot_header(n_max: usize) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "digraph search_tree {{");
+    let _ = writeln!(
+        s,
+        "  // foldsynth enumerate: N_max = {n_max}; meaningful = yellow, invalid = white, mirror = grey, isomorphic = blue"
+    );
+    let _ = writeln!(s, "  graph [rankdir=TB, ranksep=0.8, nodesep=0.1];");
+    let _ = writeln!(
+        s,
+        "  node [shape=box, style=\"filled,rounded\", fontname=\"Helvetica\", fontsize=10];"
+    );
+    let _ = writeln!(s, "  g0 [label=\"G0\", fillcolor=\"#dddddd\"];");
+    s
+}
+
+/// One generated graph and its edge from the parent, in Graphviz DOT.
+pub fn dot_node(g: &Generated<'_>) -> String {
+    let color = match g.status {
+        Status::Meaningful => "#ffd84d",
+        Status::Invalid => "#ffffff",
+        Status::Mirror => "#aaaaaa",
+        Status::Isomorphic => "#9ecae1",
+    };
+    let i = g.index;
+    let mut s = format!(
+        "  n{i} [label=\"{}\", fillcolor=\"{color}\", tooltip=\"{}, N = {}\"];\n",
+        g.graph.sequence(),
+        g.status.as_str(),
+        g.graph.internal_count()
+    );
+    match g.parent {
+        None => s += &format!("  g0 -> n{i};\n"),
+        Some(p) => s += &format!("  n{p} -> n{i};\n"),
+    }
+    s
+}
+
+/// The end of the search tree in Graphviz DOT.
+pub const DOT_FOOTER: &str = "}\n";
+
 /// The search tree of one task (Fig. 48).
 #[derive(Clone, Debug)]
 pub struct Enumeration {
@@ -217,100 +280,75 @@ pub struct Enumeration {
 pub struct TooLarge {
     /// The budget.
     pub limit: usize,
-    /// The level being generated.
+    /// The level at which it was exceeded.
     pub level: usize,
     /// The N_max requested.
     pub n_max: usize,
 }
 
-/// How many graphs an enumeration would generate: counted at smaller N_max as far as
-/// they fit the budget, then extrapolated by the last growth ratio per internal vertex.
-#[derive(Clone, Debug, PartialEq)]
-pub struct GraphEstimate {
-    /// (N_max, graphs generated) for every smaller N_max that fits the budget.
-    pub measured: Vec<(usize, usize)>,
-    /// Growth per internal vertex used to extrapolate.
-    pub ratio: f64,
-    /// The estimate at the requested N_max.
-    pub graphs: f64,
+/// One generated graph as [`Enumeration::stream`] hands it over.
+#[derive(Clone, Copy, Debug)]
+pub struct Generated<'a> {
+    /// Position in generation order (breadth-first), counting from 0.
+    pub index: usize,
+    /// Index of the parent; `None` for children of G0.
+    pub parent: Option<usize>,
+    /// Number of rule applications.
+    pub level: usize,
+    /// The filters' verdict.
+    pub status: Status,
+    /// The graph (borrowed for the call only).
+    pub graph: &'a CreaseGraph,
 }
 
-impl GraphEstimate {
-    /// Extrapolate `measured` (N_max, graphs) to `n_max` by the last growth ratio.
-    pub fn extrapolate(measured: Vec<(usize, usize)>, n_max: usize) -> GraphEstimate {
-        let ratio = match measured.as_slice() {
-            [.., (_, a), (_, b)] if *a > 0 && *b > *a => *b as f64 / *a as f64,
-            // Too little to measure: the growth seen on the bundled tasks.
-            _ => 20.0,
-        };
-        let (k, g) = measured.last().copied().unwrap_or((0, 1));
-        GraphEstimate {
-            graphs: g as f64 * ratio.powi(n_max.saturating_sub(k) as i32),
-            measured,
-            ratio,
-        }
-    }
+/// What a streamed enumeration leaves behind: counts only.
+#[derive(Clone, Debug)]
+pub struct Streamed {
+    /// Graphs generated.
+    pub generated: usize,
+    /// Whether the mirror filter actually ran (requested and the task is mirror-symmetric).
+    pub mirror_applied: bool,
+}
 
-    /// Why an enumeration at `n_max` with `filters` is refused, for the user: the
-    /// estimate, what it would take, what fits, and which switch would help.
-    pub fn refusal(&self, task: &str, n_max: usize, filters: Filters) -> String {
-        use crate::limits::{GRAPH_BYTES, GRAPHS_MAX};
-        let gb = |graphs: f64| graphs * GRAPH_BYTES as f64 / 1e9;
-        let measured: Vec<String> = self
-            .measured
-            .iter()
-            .rev()
-            .take(2)
-            .rev()
-            .map(|(k, g)| format!("{g} at N_max = {k}"))
-            .collect();
-        let mut s = format!(
-            "N_max = {n_max} is too large for task '{task}': about {:.0} graphs, about {:.0} GB in memory (counted: {}; ×{:.1} per internal vertex). One enumeration keeps at most {GRAPHS_MAX} graphs ({:.1} GB).",
-            self.graphs,
-            gb(self.graphs),
-            if measured.is_empty() {
-                "none fits".to_string()
-            } else {
-                measured.join(", ")
-            },
-            self.ratio,
-            gb(GRAPHS_MAX as f64),
-        );
-        let mut helps = Vec::new();
-        if let Some((k, _)) = self.measured.last() {
-            helps.push(format!("lower N_max to {k}"));
-        }
-        if !filters.isomorphism {
-            helps.push("switch the isomorphism filter on (drop --no-iso)".to_string());
-        }
-        if !filters.mirror {
-            helps.push("switch the mirror filter on (drop --no-mirror)".to_string());
-        }
-        if !helps.is_empty() {
-            s.push_str(&format!(" To run: {}.", helps.join(", or ")));
-        }
-        s
-    }
+/// A graph to expand at the next level: kept as its rule sequence, not as a graph, so the
+/// frontier costs a few hundred bytes per graph instead of the graph's ~15 kB.
+struct Open {
+    index: usize,
+    steps: Vec<Step>,
+}
+
+/// 128 bits of a canonical code: the filters compare codes of every graph seen so far,
+/// and a digest keeps that set small (two SipHash-1-3 of the code under different
+/// prefixes; a collision among 10^7 graphs has probability about 10^-25).
+fn code_digest(code: &Code) -> u128 {
+    use std::hash::{Hash, Hasher};
+    let half = |salt: u8| {
+        let mut h = std::hash::DefaultHasher::new();
+        salt.hash(&mut h);
+        code.hash(&mut h);
+        h.finish()
+    };
+    (u128::from(half(0)) << 64) | u128::from(half(1))
 }
 
 impl Enumeration {
-    /// Enumerate all graphs of `task` up to `n_max` internal vertices.
+    /// Enumerate all graphs of `task` up to `n_max` internal vertices, keeping every
+    /// graph (use [`Enumeration::stream`] for large N_max).
     pub fn run(task: &Task, n_max: usize, filters: Filters) -> Enumeration {
-        match Self::run_limited(task, n_max, filters, usize::MAX) {
-            Ok(e) => e,
-            Err(e) => unreachable!("no budget, yet {e}"),
-        }
+        Self::run_with(task, n_max, filters, Rules::default())
     }
 
-    /// As [`Enumeration::run`], but give up once more than `max_graphs` graphs are
-    /// generated (every graph is kept in memory, about 10 kB each).
-    pub fn run_limited(
+    /// Generate the graphs of `task` up to `n_max` internal vertices in the order of
+    /// [`Enumeration::run`] and hand each to `visit`, without keeping them: memory holds
+    /// the codes' digests of the graphs seen and the rule sequences of the graphs still
+    /// to expand, so N_max = 5 and 6 fit where keeping every graph would not.
+    pub fn stream(
         task: &Task,
         n_max: usize,
         filters: Filters,
-        max_graphs: usize,
-    ) -> Result<Enumeration, TooLarge> {
-        Self::run_limited_with(task, n_max, filters, Rules::default(), max_graphs)
+        visit: impl FnMut(Generated<'_>),
+    ) -> Streamed {
+        Self::stream_with(task, n_max, filters, Rules::default(), visit)
     }
 
     /// As [`Enumeration::run`] with a choice of rules (r2′ adds its matches after r2's).
@@ -321,6 +359,17 @@ impl Enumeration {
         }
     }
 
+    /// Enumerate keeping at most `max_graphs` graphs (for callers that must stay small,
+    /// such as the fuzzer and the Python binding).
+    pub fn run_limited(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        max_graphs: usize,
+    ) -> Result<Enumeration, TooLarge> {
+        Self::run_limited_with(task, n_max, filters, Rules::default(), max_graphs)
+    }
+
     /// As [`Enumeration::run_limited`] with a choice of rules.
     pub fn run_limited_with(
         task: &Task,
@@ -329,20 +378,77 @@ impl Enumeration {
         rules: Rules,
         max_graphs: usize,
     ) -> Result<Enumeration, TooLarge> {
+        let mut nodes = Vec::new();
+        let done = Self::stream_limited(task, n_max, filters, rules, max_graphs, |g| {
+            nodes.push(Node {
+                graph: g.graph.clone(),
+                parent: g.parent,
+                level: g.level,
+                status: g.status,
+            });
+        })?;
+        Ok(Enumeration {
+            root: CreaseGraph::initial(task),
+            nodes,
+            n_max,
+            filters,
+            mirror_applied: done.mirror_applied,
+            rules,
+        })
+    }
+
+    /// As [`Enumeration::stream`] with a choice of rules.
+    pub fn stream_with(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        rules: Rules,
+        visit: impl FnMut(Generated<'_>),
+    ) -> Streamed {
+        match Self::stream_limited(task, n_max, filters, rules, usize::MAX, visit) {
+            Ok(s) => s,
+            Err(e) => unreachable!("no budget, yet {e}"),
+        }
+    }
+
+    /// The one generator: streams at most `max_graphs` graphs, then stops with
+    /// [`TooLarge`] before generating a level's children past the budget.
+    fn stream_limited(
+        task: &Task,
+        n_max: usize,
+        filters: Filters,
+        rules: Rules,
+        max_graphs: usize,
+        mut visit: impl FnMut(Generated<'_>),
+    ) -> Result<Streamed, TooLarge> {
         let root = CreaseGraph::initial(task);
         let mirror_applied =
             filters.mirror && task.symmetry.mirror_xz && root.initial_graph().mirror.is_some();
-        let mut nodes: Vec<Node> = Vec::new();
-        // Codes of all graphs seen so far, and of those kept (neither isomorphic nor mirror).
-        let mut seen: HashSet<Code> = HashSet::new();
-        let mut kept: HashSet<Code> = HashSet::new();
-        let mut frontier: Vec<Option<usize>> = vec![None];
+        // Digests of all codes seen so far, and of those kept (neither isomorphic nor
+        // mirror).
+        let mut seen: HashSet<u128> = HashSet::new();
+        let mut kept: HashSet<u128> = HashSet::new();
+        let mut frontier: Vec<Option<Open>> = vec![None];
+        let mut generated = 0;
         let mut level = 0;
         while !frontier.is_empty() {
             level += 1;
             let mut next = Vec::new();
             for parent in frontier {
-                let g = parent.map_or(&root, |i| &nodes[i].graph);
+                // The parent rebuilt from its sequence: the same rule applications that
+                // made it, so the same graph.
+                let g = match &parent {
+                    None => root.clone(),
+                    Some(open) => {
+                        let mut g = root.clone();
+                        for &step in &open.steps {
+                            g.apply_step(step)
+                                .expect("a generated graph's own sequence applies");
+                        }
+                        g
+                    }
+                };
+                let parent_index = parent.as_ref().map(|o| o.index);
                 let mut children = Vec::new();
                 if rules.r1 {
                     for v in g.r1_matches(n_max) {
@@ -366,7 +472,7 @@ impl Enumeration {
                         children.push(c);
                     }
                 }
-                if nodes.len() + children.len() > max_graphs {
+                if generated + children.len() > max_graphs {
                     return Err(TooLarge {
                         limit: max_graphs,
                         level,
@@ -374,17 +480,20 @@ impl Enumeration {
                     });
                 }
                 for graph in children {
-                    let code = graph.canonical_code();
-                    let status = if filters.isomorphism && !seen.insert(code.clone()) {
+                    let code = code_digest(&graph.canonical_code());
+                    let status = if filters.isomorphism && !seen.insert(code) {
                         Status::Isomorphic
                     } else if mirror_applied
                         && graph
                             .mirror_code()
+                            .map(|m| code_digest(&m))
                             .is_some_and(|m| m != code && kept.contains(&m))
                     {
                         Status::Mirror
                     } else {
-                        kept.insert(code);
+                        if mirror_applied {
+                            kept.insert(code);
+                        }
                         if filters.validity && !graph.is_semantically_valid() {
                             Status::Invalid
                         } else {
@@ -392,61 +501,27 @@ impl Enumeration {
                         }
                     };
                     if matches!(status, Status::Meaningful | Status::Invalid) {
-                        next.push(Some(nodes.len()));
+                        next.push(Some(Open {
+                            index: generated,
+                            steps: graph.sequence_steps(),
+                        }));
                     }
-                    nodes.push(Node {
-                        graph,
-                        parent,
+                    visit(Generated {
+                        index: generated,
+                        parent: parent_index,
                         level,
                         status,
+                        graph: &graph,
                     });
+                    generated += 1;
                 }
             }
             frontier = next;
         }
-        Ok(Enumeration {
-            root,
-            nodes,
-            n_max,
-            filters,
+        Ok(Streamed {
+            generated,
             mirror_applied,
-            rules,
         })
-    }
-
-    /// Enumerate up to `n_max` keeping at most `max_graphs` graphs, or say why not with an
-    /// estimate. The smaller N_max are counted first (together about a twentieth of the
-    /// last): an N_max whose extrapolated size is far beyond the budget is refused without
-    /// being tried, so the refusal costs no more memory than the largest N_max that fits.
-    pub fn run_within(
-        task: &Task,
-        n_max: usize,
-        filters: Filters,
-        max_graphs: usize,
-    ) -> Result<Enumeration, GraphEstimate> {
-        Self::run_within_with(task, n_max, filters, Rules::default(), max_graphs)
-    }
-
-    /// As [`Enumeration::run_within`] with a choice of rules.
-    pub fn run_within_with(
-        task: &Task,
-        n_max: usize,
-        filters: Filters,
-        rules: Rules,
-        max_graphs: usize,
-    ) -> Result<Enumeration, GraphEstimate> {
-        let mut measured = Vec::new();
-        for k in 1..n_max {
-            match Self::run_limited_with(task, k, filters, rules, max_graphs) {
-                Ok(e) => measured.push((k, e.nodes.len())),
-                Err(_) => return Err(GraphEstimate::extrapolate(measured, n_max)),
-            }
-        }
-        let estimate = GraphEstimate::extrapolate(measured, n_max);
-        if estimate.graphs > 2.0 * max_graphs as f64 {
-            return Err(estimate);
-        }
-        Self::run_limited_with(task, n_max, filters, rules, max_graphs).map_err(|_| estimate)
     }
 
     /// The generated graph with this rule sequence, if it was generated.
@@ -474,22 +549,9 @@ impl Enumeration {
 
     /// Counts per level.
     pub fn level_counts(&self) -> Vec<LevelCounts> {
-        let depth = self.nodes.iter().map(|n| n.level).max().unwrap_or(0);
-        let mut out: Vec<LevelCounts> = (1..=depth)
-            .map(|level| LevelCounts {
-                level,
-                ..LevelCounts::default()
-            })
-            .collect();
+        let mut out = Vec::new();
         for n in &self.nodes {
-            let c = &mut out[n.level - 1];
-            c.generated += 1;
-            match n.status {
-                Status::Meaningful => c.meaningful += 1,
-                Status::Invalid => c.invalid += 1,
-                Status::Mirror => c.mirror += 1,
-                Status::Isomorphic => c.isomorphic += 1,
-            }
+            LevelCounts::count(&mut out, n.level, n.status);
         }
         out
     }
@@ -497,43 +559,17 @@ impl Enumeration {
     /// The search tree as Graphviz DOT (Fig. 48): one node per generated graph, coloured
     /// by status (meaningful yellow, invalid white, mirror grey, isomorphic blue).
     pub fn to_dot(&self) -> String {
-        let mut s = String::new();
-        let _ = writeln!(s, "digraph search_tree {{");
-        let _ = writeln!(
-            s,
-            "  // foldsynth enumerate: N_max = {}; meaningful = yellow, invalid = white, mirror = grey, isomorphic = blue",
-            self.n_max
-        );
-        let _ = writeln!(s, "  graph [rankdir=TB, ranksep=0.8, nodesep=0.1];");
-        let _ = writeln!(
-            s,
-            "  node [shape=box, style=\"filled,rounded\", fontname=\"Helvetica\", fontsize=10];"
-        );
-        let _ = writeln!(s, "  g0 [label=\"G0\", fillcolor=\"#dddddd\"];");
+        let mut s = dot_header(self.n_max);
         for (i, n) in self.nodes.iter().enumerate() {
-            let color = match n.status {
-                Status::Meaningful => "#ffd84d",
-                Status::Invalid => "#ffffff",
-                Status::Mirror => "#aaaaaa",
-                Status::Isomorphic => "#9ecae1",
-            };
-            let _ = writeln!(
-                s,
-                "  n{i} [label=\"{}\", fillcolor=\"{color}\", tooltip=\"{}, N = {}\"];",
-                n.graph.sequence(),
-                n.status.as_str(),
-                n.graph.internal_count()
-            );
-            match n.parent {
-                None => {
-                    let _ = writeln!(s, "  g0 -> n{i};");
-                }
-                Some(p) => {
-                    let _ = writeln!(s, "  n{p} -> n{i};");
-                }
-            }
+            s += &dot_node(&Generated {
+                index: i,
+                parent: n.parent,
+                level: n.level,
+                status: n.status,
+                graph: &n.graph,
+            });
         }
-        s.push_str("}\n");
+        s.push_str(DOT_FOOTER);
         s
     }
 }

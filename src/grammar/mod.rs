@@ -88,7 +88,8 @@ mod straight;
 
 pub use canon::Code;
 pub use enumerate::{
-    Enumeration, Filters, GraphEstimate, LevelCounts, Node, Rules, Status, TooLarge,
+    DOT_FOOTER, Enumeration, Filters, Generated, LevelCounts, Node, Rules, Status, Streamed,
+    TooLarge, dot_header, dot_node,
 };
 pub use graph::{CreaseGraph, FacetBoundary, FacetError};
 pub use notation::{NotationError, Step, format_sequence, parse_sequence};

@@ -11,7 +11,7 @@
 //!   With `--force` a foldsynth run of other settings is replaced (its listed files
 //!   deleted) and a foreign directory is written into without deleting anything.
 //! - `--resume` reuses `alternatives.jsonl` only when `settings.json` is readable and equal
-//!   to this run's settings; [`read_records`] says how many records it reused and why it
+//!   to this run's settings; [`keep_records`] says how many records it reused and why it
 //!   dropped any.
 
 use std::collections::{BTreeSet, HashSet};
@@ -56,6 +56,71 @@ pub struct RunSettings {
     pub rules: Option<String>,
     /// Optimized without the clearance and margin constraints (`--post-check-only`).
     pub post_check_only: bool,
+    /// The share of the search this directory holds (`synthesize --shard K/N`); absent
+    /// for a whole run (and for `merge`'s result, which is one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<ShardSpec>,
+}
+
+/// Shard K of N (1 ≤ K ≤ N), written `K/N`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub struct ShardSpec {
+    /// K, from 1.
+    pub index: usize,
+    /// N.
+    pub count: usize,
+}
+
+impl std::fmt::Display for ShardSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl std::str::FromStr for ShardSpec {
+    type Err = String;
+    fn from_str(s: &str) -> Result<ShardSpec, String> {
+        let shown = excerpt(s);
+        let usage = "write K/N with whole numbers 1 ≤ K ≤ N, e.g. 3/16 (shard 3 of 16)";
+        let (k, n) = s
+            .split_once('/')
+            .ok_or_else(|| format!("'{shown}' is not a shard: {usage}"))?;
+        let num = |t: &str, what: &str| {
+            t.trim().parse::<usize>().map_err(|_| {
+                format!(
+                    "'{shown}': {what} '{}' is not a whole number; {usage}",
+                    excerpt(t)
+                )
+            })
+        };
+        let (index, count) = (num(k, "K")?, num(n, "N")?);
+        if count == 0 || count > crate::limits::SHARDS_MAX {
+            return Err(format!(
+                "'{shown}': N = {count} shards; allowed 1 to {}",
+                crate::limits::SHARDS_MAX
+            ));
+        }
+        if index == 0 || index > count {
+            return Err(format!(
+                "'{shown}': shard {index} of {count} does not exist; shards are numbered 1 to {count}"
+            ));
+        }
+        Ok(ShardSpec { index, count })
+    }
+}
+
+impl TryFrom<String> for ShardSpec {
+    type Error = String;
+    fn try_from(s: String) -> Result<ShardSpec, String> {
+        s.parse()
+    }
+}
+
+impl From<ShardSpec> for String {
+    fn from(s: ShardSpec) -> String {
+        s.to_string()
+    }
 }
 
 impl RunSettings {
@@ -461,24 +526,37 @@ impl OutputDir {
     /// Create the directory `rel` (listed in the manifest when this run creates it).
     /// A symbolic link there is refused: it could lead writes out of the directory.
     pub fn create_dir(&self, rel: &str) -> Result<PathBuf, OutputError> {
-        let path = self.root.join(rel);
-        match fs::symlink_metadata(&path) {
-            Ok(m) if m.is_dir() => return Ok(path),
-            Ok(_) => {
-                return Err(OutputError::Refused {
-                    path: path.display().to_string(),
-                    message: "exists and is not a directory (a file or a link); foldsynth writes its designs into a directory of its own there".into(),
-                });
+        Ok(self.create_dirs(&[rel.to_string()])?.remove(0))
+    }
+
+    /// [`OutputDir::create_dir`] for several directories, listed in one step.
+    pub fn create_dirs(&self, rels: &[String]) -> Result<Vec<PathBuf>, OutputError> {
+        let mut new = Vec::new();
+        for rel in rels {
+            let path = self.root.join(rel);
+            match fs::symlink_metadata(&path) {
+                Ok(m) if m.is_dir() => {}
+                Ok(_) => {
+                    return Err(OutputError::Refused {
+                        path: path.display().to_string(),
+                        message: "exists and is not a directory (a file or a link); foldsynth writes its designs into a directory of its own there".into(),
+                    });
+                }
+                Err(_) => new.push(rel),
             }
-            Err(_) => {}
         }
-        {
+        if !new.is_empty() {
             let mut m = self.manifest.lock().unwrap_or_else(|e| e.into_inner());
-            m.dirs.insert(rel.to_string());
+            m.dirs.extend(new.iter().map(|r| r.to_string()));
             Self::write_manifest(&self.root, &m)?;
         }
-        fs::create_dir_all(&path).map_err(io_err(&path))?;
-        Ok(path)
+        let mut out = Vec::with_capacity(rels.len());
+        for rel in rels {
+            let path = self.root.join(rel);
+            fs::create_dir_all(&path).map_err(io_err(&path))?;
+            out.push(path);
+        }
+        Ok(out)
     }
 
     /// Write a whole file (listed first).
@@ -512,8 +590,22 @@ pub struct Dropped {
 pub struct ResumeReport {
     /// Records reused.
     pub reused: usize,
-    /// Lines not reused, and why.
+    /// Lines not reused, and why (the first [`DROPPED_SHOWN`]).
     pub dropped: Vec<Dropped>,
+    /// Lines not reused in all.
+    pub dropped_total: usize,
+}
+
+/// How many dropped lines a [`ResumeReport`] keeps to show.
+pub const DROPPED_SHOWN: usize = 100;
+
+impl ResumeReport {
+    fn drop_line(&mut self, d: Dropped) {
+        self.dropped_total += 1;
+        if self.dropped.len() < DROPPED_SHOWN {
+            self.dropped.push(d);
+        }
+    }
 }
 
 impl ResumeReport {
@@ -524,7 +616,7 @@ impl ResumeReport {
             self.reused,
             file.display()
         );
-        if self.dropped.is_empty() {
+        if self.dropped_total == 0 {
             s.push_str("; dropped none");
         } else {
             let shown: Vec<String> = self
@@ -535,10 +627,10 @@ impl ResumeReport {
                 .collect();
             s.push_str(&format!(
                 "; dropped {} (evaluated again): {}{}",
-                self.dropped.len(),
+                self.dropped_total,
                 shown.join("; "),
-                if self.dropped.len() > 5 {
-                    format!("; and {} more", self.dropped.len() - 5)
+                if self.dropped_total > 5 {
+                    format!("; and {} more", self.dropped_total - 5)
                 } else {
                     String::new()
                 }
@@ -546,6 +638,80 @@ impl ResumeReport {
         }
         s
     }
+}
+
+/// Keep the records of an earlier run of the same settings and open the file to append
+/// new ones. `keep` says whether a record belongs to this search (and is not a repeat:
+/// `Err(why)` otherwise). Every line that is not kept is reported: a torn last line (the
+/// run was killed while writing it), a line that is not a record, a key this search does
+/// not have, a repeated key. The kept lines are copied, as they were, into a new file
+/// that replaces the old one, one line at a time: memory does not grow with the records.
+/// Without `resume` the file starts empty.
+pub fn keep_records(
+    dir: &OutputDir,
+    resume: bool,
+    keep: &mut dyn FnMut(&AlternativeRecord) -> Result<(), String>,
+) -> Result<(File, Option<ResumeReport>), OutputError> {
+    let path = dir.path(RECORDS);
+    let open_append = |path: &Path| {
+        fs::OpenOptions::new()
+            .append(true)
+            .open(path)
+            .map_err(io_err(path))
+    };
+    if !resume {
+        dir.create(RECORDS)?;
+        return Ok((open_append(&path)?, None));
+    }
+    let mut report = ResumeReport::default();
+    let file = match File::open(&path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            dir.create(RECORDS)?;
+            return Ok((open_append(&path)?, Some(report)));
+        }
+        r => r.map_err(io_err(&path))?,
+    };
+    let tmp_rel = format!("{RECORDS}.resume");
+    let (tmp, out) = dir.create(&tmp_rel)?;
+    let mut out = std::io::BufWriter::new(out);
+    let mut reader = BufReader::new(file);
+    let mut buf = Vec::new();
+    let mut line = 0;
+    loop {
+        buf.clear();
+        if reader.read_until(b'\n', &mut buf).map_err(io_err(&path))? == 0 {
+            break;
+        }
+        line += 1;
+        let why = if !buf.ends_with(b"\n") {
+            // Only the last line can lack its newline: a kill tore it, whatever it holds.
+            Some("torn (no newline at the end: the run was killed while writing it)".into())
+        } else {
+            match std::str::from_utf8(&buf) {
+                Err(_) => Some("not UTF-8 text".to_string()),
+                Ok(t) if t.trim().is_empty() => continue,
+                Ok(t) => match serde_json::from_str::<AlternativeRecord>(t) {
+                    Err(e) => Some(format!("not a record ({})", excerpt(&e.to_string()))),
+                    Ok(r) => match keep(&r) {
+                        Err(why) => Some(why),
+                        Ok(()) => {
+                            out.write_all(&buf).map_err(io_err(&tmp))?;
+                            report.reused += 1;
+                            None
+                        }
+                    },
+                },
+            }
+        };
+        if let Some(why) = why {
+            report.drop_line(Dropped { line, why });
+        }
+    }
+    out.flush().map_err(io_err(&tmp))?;
+    drop(out);
+    // The old file stays whole until the new one replaces it in one step.
+    fs::rename(&tmp, &path).map_err(io_err(&path))?;
+    Ok((open_append(&path)?, Some(report)))
 }
 
 /// Read the records of an earlier run of the same settings. `wanted` says which keys
@@ -605,23 +771,9 @@ pub fn parse_records(
             }
         };
         if let Some(why) = why {
-            report.dropped.push(Dropped { line, why });
+            report.drop_line(Dropped { line, why });
         }
     }
     report.reused = out.len();
     Ok((out, report))
-}
-
-/// A line-per-record writer that lists the file in the manifest and flushes every line.
-pub fn write_records(
-    dir: &OutputDir,
-    records: &[AlternativeRecord],
-) -> Result<(PathBuf, File), OutputError> {
-    let (path, mut f) = dir.create(RECORDS)?;
-    for r in records {
-        let line = serde_json::to_string(r).unwrap_or_default();
-        writeln!(f, "{line}").map_err(io_err(&path))?;
-    }
-    f.flush().map_err(io_err(&path))?;
-    Ok((path, f))
 }

@@ -161,22 +161,82 @@ pub struct LevelCounts {
 
 /// The distribution of the records over rule applications.
 pub fn level_distribution(records: &[AlternativeRecord]) -> Vec<LevelCounts> {
-    let max = records.iter().map(|r| r.level).max().unwrap_or(0);
-    (1..=max)
-        .map(|level| {
-            let at: Vec<&AlternativeRecord> = records.iter().filter(|r| r.level == level).collect();
-            LevelCounts {
-                level,
-                alternatives: at.len(),
-                meets_target: at.iter().filter(|r| r.meets_target).count(),
-                no_self_intersection: at
-                    .iter()
-                    .filter(|r| r.meets_target && r.self_intersection_free == Some(true))
-                    .count(),
-                no_intersection: at.iter().filter(|r| r.thesis_feasible()).count(),
-            }
-        })
-        .collect()
+    let mut t = Tally::default();
+    for r in records {
+        t.add(r);
+    }
+    t.levels
+}
+
+/// The counts of a summary, added up one record at a time (a search reads its records
+/// file line by line instead of keeping the records).
+#[derive(Clone, Debug, Default)]
+pub struct Tally {
+    /// Records.
+    pub records: usize,
+    /// Meeting the target.
+    pub meets_target: usize,
+    /// … and free of self-intersection.
+    pub no_self_intersection: usize,
+    /// … and clear of obstacles.
+    pub no_intersection: usize,
+    /// … and rigid over the whole motion, verified.
+    pub feasible: usize,
+    /// Meeting the target, rigid at t_max but not over the whole motion.
+    pub rigid_at_tmax_only: usize,
+    /// Verification failures.
+    pub verification_failures: usize,
+    /// Per number of rule applications, from 1.
+    pub levels: Vec<LevelCounts>,
+    /// Milliseconds optimizing, summed.
+    pub optimize_ms: f64,
+    /// Milliseconds checking, summed.
+    pub check_ms: f64,
+    /// Feasible designs that meet every robustness margin the task sets.
+    pub meets_margins: usize,
+    /// Feasible designs within 1e-3 of the rigidity limit.
+    pub near_rigid_limit: usize,
+    /// The records from cyclic graphs (r2′); `graphs` is left 0.
+    pub cyclic: CyclicCounts,
+}
+
+impl Tally {
+    /// Count one record.
+    pub fn add(&mut self, r: &AlternativeRecord) {
+        let no_self = r.meets_target && r.self_intersection_free == Some(true);
+        self.records += 1;
+        self.meets_target += usize::from(r.meets_target);
+        self.no_self_intersection += usize::from(no_self);
+        self.no_intersection += usize::from(r.thesis_feasible());
+        self.feasible += usize::from(r.feasible_design());
+        self.rigid_at_tmax_only += usize::from(
+            r.meets_target
+                && r.verification
+                    .as_ref()
+                    .is_some_and(|v| v.rigid_at_tmax && !v.rigid_over_motion),
+        );
+        self.verification_failures += usize::from(r.verification_failed == Some(true));
+        self.optimize_ms += r.optimize_ms;
+        self.check_ms += r.check_ms;
+        if r.feasible_design() {
+            let rob = r.robustness.as_ref();
+            self.meets_margins += usize::from(rob.is_some_and(|x| x.meets_settings()));
+            self.near_rigid_limit += usize::from(rob.is_some_and(|x| x.rigid_margin.value < 1e-3));
+        }
+        self.cyclic.add(r);
+        while self.levels.len() < r.level {
+            self.levels.push(LevelCounts {
+                level: self.levels.len() + 1,
+                ..LevelCounts::default()
+            });
+        }
+        if let Some(l) = r.level.checked_sub(1).and_then(|i| self.levels.get_mut(i)) {
+            l.alternatives += 1;
+            l.meets_target += usize::from(r.meets_target);
+            l.no_self_intersection += usize::from(no_self);
+            l.no_intersection += usize::from(r.thesis_feasible());
+        }
+    }
 }
 
 /// One design in the ranking of `summary.json`.
@@ -262,31 +322,34 @@ pub struct CyclicCounts {
 impl CyclicCounts {
     /// Count the cyclic records among `records`.
     pub fn count(graphs: usize, records: &[AlternativeRecord]) -> CyclicCounts {
-        let cyc: Vec<&AlternativeRecord> = records.iter().filter(|r| r.is_cyclic()).collect();
-        let verdict = |r: &&&AlternativeRecord| r.cycle.clone();
-        CyclicCounts {
+        let mut c = CyclicCounts {
             graphs,
-            alternatives: cyc.len(),
-            meets_target: cyc.iter().filter(|r| r.meets_target).count(),
-            no_intersection: cyc.iter().filter(|r| r.thesis_feasible()).count(),
-            sweep_passes: cyc
-                .iter()
-                .filter(|r| {
-                    verdict(r).is_some_and(|v| v.sweep.passes(crate::check::cycle::CYCLE_TOL))
-                })
-                .count(),
-            simulation_agrees: cyc
-                .iter()
-                .filter(|r| verdict(r).is_some_and(|v| v.simulation.is_some_and(|s| s.agrees)))
-                .count(),
-            feasible: cyc.iter().filter(|r| r.feasible_design()).count(),
-            feasible_folding_shared_crease: cyc
-                .iter()
-                .filter(|r| {
-                    r.feasible_design() && verdict(r).is_some_and(|v| v.sweep.folds_shared_crease())
-                })
-                .count(),
+            ..CyclicCounts::default()
+        };
+        for r in records {
+            c.add(r);
         }
+        c
+    }
+
+    /// Count one record (nothing unless it is cyclic): records are counted as they are
+    /// read, so a streamed search keeps none.
+    pub fn add(&mut self, r: &AlternativeRecord) {
+        if !r.is_cyclic() {
+            return;
+        }
+        let verdict = r.cycle.as_ref();
+        let feasible = r.feasible_design();
+        self.alternatives += 1;
+        self.meets_target += usize::from(r.meets_target);
+        self.no_intersection += usize::from(r.thesis_feasible());
+        self.sweep_passes +=
+            usize::from(verdict.is_some_and(|v| v.sweep.passes(crate::check::cycle::CYCLE_TOL)));
+        self.simulation_agrees +=
+            usize::from(verdict.is_some_and(|v| v.simulation.as_ref().is_some_and(|s| s.agrees)));
+        self.feasible += usize::from(feasible);
+        self.feasible_folding_shared_crease +=
+            usize::from(feasible && verdict.is_some_and(|v| v.sweep.folds_shared_crease()));
     }
 }
 

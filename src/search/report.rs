@@ -4,10 +4,10 @@
 
 use super::record::{AlternativeRecord, LevelCounts, Summary};
 use super::run::SearchOptions;
-use crate::export::plots::{DistributionPlot, NodeStatus, Series, TreeNode};
+use crate::export::plots::{DistributionPlot, Series, TreeNode};
 use crate::export::report::{CountRow, Fact, ReportDesign, ReportInput, ReportSummary, TimingRow};
 use crate::export::{DesignMeta, Files, verify::VerifyReport};
-use crate::grammar::{Enumeration, Status, VertexType};
+use crate::grammar::VertexType;
 use crate::pattern::Pattern;
 use crate::task::Task;
 use std::path::PathBuf;
@@ -289,7 +289,7 @@ pub(super) fn report_design(
 /// The report's content.
 pub(super) fn report_input(
     task: &Task,
-    enumeration: &Enumeration,
+    tree: Vec<TreeNode>,
     s: &Summary,
     task_rows: Vec<Fact>,
     designs: Vec<ReportDesign>,
@@ -326,23 +326,6 @@ pub(super) fn report_input(
         timing("check + verify (CPU)", t.check_s),
         timing("search before export (wall)", t.total_s),
     ];
-    let tree = enumeration
-        .nodes
-        .iter()
-        .enumerate()
-        .map(|(i, n)| TreeNode {
-            id: i,
-            parent: n.parent,
-            label: n.graph.sequence(),
-            level: n.level,
-            status: match n.status {
-                Status::Meaningful => NodeStatus::Meaningful,
-                Status::Invalid => NodeStatus::Invalid,
-                Status::Mirror => NodeStatus::Mirror,
-                Status::Isomorphic => NodeStatus::Isomorphic,
-            },
-        })
-        .collect();
     let series = |name: &str, f: &dyn Fn(&LevelCounts) -> usize| Series {
         name: name.into(),
         points: s

@@ -1,10 +1,9 @@
 //! Running a search: scheduling, streaming, resuming, summarizing, exporting.
 
-use super::output::{self, OutputDir, RECORDS, RunSettings, SETTINGS};
+use super::output::{self, OutputDir, RECORDS, RunSettings, SETTINGS, ShardSpec};
+use super::plan::{Done, Plan};
 use super::progress::Progress;
-use super::record::{
-    AlternativeRecord, CyclicCounts, RankEntry, Summary, Timings, level_distribution,
-};
+use super::record::{AlternativeRecord, RankEntry, Summary, Tally, Timings};
 use super::report::{report_design, report_input, task_facts};
 use crate::check::robustness::{self, RobustnessInput, UnitCreases};
 use crate::check::verify::{Tolerances, verify};
@@ -12,7 +11,7 @@ use crate::check::{CheckError, Checker, Cylinder, MotionSettings, check_states, 
 use crate::compile::Options as CompileOptions;
 use crate::cpu_time::Stopwatch;
 use crate::export::{self, DesignMeta, ExportOptions};
-use crate::grammar::{CreaseGraph, Enumeration, Filters, Rules};
+use crate::grammar::{CreaseGraph, Rules};
 use crate::limits;
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
@@ -22,11 +21,13 @@ use crate::optimize::{self, minimize, minimize_robust};
 use crate::pattern::Pattern;
 use crate::task::Task;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use serde_json::json;
-use std::collections::{BTreeMap, HashMap};
-use std::io::Write;
-use std::path::PathBuf;
-use std::sync::{Arc, Mutex};
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufRead, BufReader, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// Settings of a search.
@@ -102,6 +103,16 @@ pub enum SearchError {
         /// The error.
         source: std::io::Error,
     },
+    /// A records file holds a line that is not a record of this search.
+    #[error("{path}, line {line}: {message}")]
+    Records {
+        /// The file.
+        path: String,
+        /// 1-based line number (0: unknown).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
     /// The output directory cannot be used (see [`super::output`]).
     #[error(transparent)]
     Output(#[from] output::OutputError),
@@ -161,18 +172,6 @@ pub struct Prepared {
     pub compiled: CompiledModel,
     /// Its robustness block (absent with `--post-check-only`).
     pub robust: Option<RobustModel>,
-}
-
-/// The compiled model of one (graph, candidate) while its alternatives are evaluated.
-struct Slot {
-    /// The model, or why it failed; `None` before the first alternative and after the last.
-    model: Option<Result<Arc<Prepared>, String>>,
-    /// CPU seconds spent compiling (the compiling thread's clock).
-    seconds: f64,
-    /// Alternatives of this slot still to evaluate.
-    remaining: usize,
-    /// Whether a failure was reported (once per slot).
-    reported: bool,
 }
 
 /// Build and compile the model of one graph and candidate, with its robustness block
@@ -523,10 +522,73 @@ pub fn remeasure(
     measure_robustness(task, &model, &arm, &pat)
 }
 
-/// Run the search of `task` and write everything under `opts.out`.
-pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
-    let start = Instant::now();
-    let cpu0 = crate::cpu_time::process_seconds();
+/// Which part of the search a run evaluates: a shard's units (see `distribute`).
+#[derive(Clone, Copy, Debug)]
+pub struct Share<'a> {
+    /// The shard, as its settings record it.
+    pub spec: ShardSpec,
+    /// Its units (indices into [`Plan::units`]).
+    pub units: &'a [usize],
+    /// The task file's text: kept in the shard's directory (`task.toml`) so that
+    /// `merge` rebuilds the designs from exactly the task the shard ran.
+    pub task_text: &'a str,
+}
+
+/// A model that could not be built or compiled: its alternatives have no records.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FailedModel {
+    /// The graph's rule sequence.
+    pub sequence: String,
+    /// Gripping candidate 1, 2, 3.
+    pub candidate: usize,
+    /// Why.
+    pub error: String,
+}
+
+/// What evaluating (part of) a search did, besides writing its records.
+#[derive(Clone, Debug, Default)]
+pub struct Evaluation {
+    /// Seconds spent compiling (summed over the workers).
+    pub compile_s: f64,
+    /// Worker threads.
+    pub jobs: usize,
+    /// Records reused from an earlier run (`--resume`).
+    pub resumed: usize,
+    /// What `--resume` kept and dropped.
+    pub resume: Option<output::ResumeReport>,
+    /// Models that failed.
+    pub failed: Vec<FailedModel>,
+}
+
+/// What a shard's run leaves in `OUT/shard.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ShardReport {
+    /// The shard.
+    pub shard: ShardSpec,
+    /// Units (compiled models) in the shard.
+    pub units: usize,
+    /// Alternatives in the shard.
+    pub alternatives: u64,
+    /// Records in `alternatives.jsonl` (all of the shard's alternatives but those of
+    /// failed models once it is complete).
+    pub records: usize,
+    /// Estimated cost of the shard (see `plan::Unit::cost`).
+    pub cost: u64,
+    /// Estimated cost of the whole search.
+    pub total_cost: u64,
+    /// Models that failed (their alternatives have no records).
+    pub failed_models: Vec<FailedModel>,
+    /// Time per stage; `total_s` is this run's wall time.
+    pub timings: Timings,
+}
+
+/// The shard's report file.
+pub const SHARD_REPORT: &str = "shard.json";
+/// The task file a shard keeps.
+pub const SHARD_TASK: &str = "task.toml";
+
+/// Check that `task` can be searched with `opts`; the N_max to use.
+pub fn check_search(task: &Task, opts: &SearchOptions) -> Result<usize, SearchError> {
     let terr = |m: &str| SearchError::Task {
         task: task.name.clone(),
         message: m.to_string(),
@@ -555,54 +617,31 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     for (what, value, min, max) in counts {
         limits::check_count(what, value, min, max).map_err(|m| terr(&m))?;
     }
+    Ok(n_max)
+}
 
-    let progress = Progress::new(opts.progress);
-    progress.phase("enumerate graphs", "graphs", None);
-    let t0 = Instant::now();
-    let enumeration =
-        Enumeration::run_within_with(task, n_max, Filters::all(), opts.rules, limits::GRAPHS_MAX)
-            .map_err(|est| terr(&est.refusal(&task.name, n_max, Filters::all())))?;
-    let graphs: Vec<&CreaseGraph> = enumeration.meaningful().map(|n| &n.graph).collect();
-    let enumerate_s = t0.elapsed().as_secs_f64();
-    progress.inc(graphs.len() as u64);
-    progress.finish_phase_with(&format!(
-        "{} generated, {} meaningful",
-        enumeration.nodes.len(),
-        graphs.len()
-    ));
-    if graphs.is_empty() {
-        return Err(terr(&format!(
-            "G0 generates no meaningful graph up to N_max = {n_max} (see `foldsynth enumerate`): there is nothing to optimize"
-        )));
+/// The plan of `task`'s search at `n_max`; an error when there is nothing to search.
+pub fn plan(task: &Task, n_max: usize, rules: Rules) -> Result<Plan, SearchError> {
+    let plan = Plan::with_rules(task, n_max, rules);
+    if plan.graphs.is_empty() {
+        return Err(SearchError::Task {
+            task: task.name.clone(),
+            message: format!(
+                "G0 generates no meaningful graph up to N_max = {n_max} (see `foldsynth enumerate`): there is nothing to optimize"
+            ),
+        });
     }
-    let count = enumeration.alternatives();
-    if count > limits::ALTERNATIVES_MAX {
-        return Err(terr(&format!(
-            "N_max = {n_max} gives {count} design alternatives ({} graphs); one search evaluates at most {} (each takes tens of milliseconds and keeps a record in memory). Lower N_max.",
-            graphs.len(),
-            limits::ALTERNATIVES_MAX
-        )));
-    }
+    Ok(plan)
+}
 
-    let mut alternatives = Vec::new();
-    for (g, graph) in graphs.iter().enumerate() {
-        let n = graph.internal_count();
-        for candidate in 0..3 {
-            for modes in 0..(1u32 << n) {
-                alternatives.push(Alternative {
-                    graph: g,
-                    candidate,
-                    modes,
-                    n,
-                    sequence: graph.sequence(),
-                });
-            }
-        }
-    }
-
-    // The settings that decide the results: the output directory holds only runs of
-    // these settings (see `output`).
-    let settings = RunSettings {
+/// The settings of a search of `task` at `n_max` with `opts` (and of shard `shard`).
+pub fn settings(
+    task: &Task,
+    n_max: usize,
+    opts: &SearchOptions,
+    shard: Option<ShardSpec>,
+) -> RunSettings {
+    RunSettings {
         task: task.name.clone(),
         task_digest: task.digest.clone(),
         n_max,
@@ -612,128 +651,205 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         foldsynth: env!("CARGO_PKG_VERSION").into(),
         rules: (opts.rules != Rules::default()).then(|| opts.rules.names()),
         post_check_only: opts.post_check_only,
-    };
-    let opened = OutputDir::open(&opts.out, &settings, opts.resume, opts.force)?;
+        shard,
+    }
+}
+
+/// Open the output directory for a run of `settings` and write its settings file.
+pub fn open_output(
+    settings: &RunSettings,
+    opts: &SearchOptions,
+) -> Result<(OutputDir, bool), SearchError> {
+    let opened = OutputDir::open(&opts.out, settings, opts.resume, opts.force)?;
     for note in &opened.notes {
         eprintln!("note: {note}");
     }
     let out = opened.dir;
     out.write(
         SETTINGS,
-        serde_json::to_string_pretty(&settings).unwrap_or_default() + "\n",
+        serde_json::to_string_pretty(settings).unwrap_or_default() + "\n",
     )?;
-    let wanted: HashMap<String, usize> = alternatives
-        .iter()
-        .enumerate()
-        .map(|(i, a)| (a.key(), i))
-        .collect();
-    let (done, resume) = if opened.resume {
-        let path = out.path(RECORDS);
-        let (done, report) = output::read_records(&path, &|k| wanted.contains_key(k))?;
-        eprintln!("{}", report.text(&path));
-        (done, Some(report))
-    } else {
-        (Vec::new(), None)
+    Ok((out, opened.resume))
+}
+
+/// Run the search of `task` and write everything under `opts.out`.
+pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
+    let start = Instant::now();
+    let n_max = check_search(task, opts)?;
+    let progress = Progress::new(opts.progress);
+    progress.phase("enumerate graphs", "graphs", None);
+    let plan = plan(task, n_max, opts.rules)?;
+    progress.inc(plan.graphs.len() as u64);
+    progress.finish_phase_with(&format!(
+        "{} generated, {} meaningful",
+        plan.generated,
+        plan.graphs.len()
+    ));
+    let (out, resume) = open_output(&settings(task, n_max, opts, None), opts)?;
+    let all: Vec<usize> = (0..plan.units.len()).collect();
+    let ev = evaluate_units(task, &plan, &all, &out, resume, opts, &progress)?;
+    finish(task, &plan, &out, opts, &ev, start, &progress)
+}
+
+/// Run shard `share` of the search of `task` (planned as `plan`) into `opts.out`: its
+/// records, the task file and `shard.json`; `merge` makes the whole run of the shards.
+pub fn run_shard(
+    task: &Task,
+    plan: &Plan,
+    share: Share<'_>,
+    opts: &SearchOptions,
+) -> Result<ShardReport, SearchError> {
+    let start = Instant::now();
+    let n_max = check_search(task, opts)?;
+    let (out, resume) = open_output(&settings(task, n_max, opts, Some(share.spec)), opts)?;
+    out.write(SHARD_TASK, share.task_text)?;
+    let progress = Progress::new(opts.progress);
+    let ev = evaluate_units(task, plan, share.units, &out, resume, opts, &progress)?;
+    drop(progress);
+    let tally = tally_records(plan, &out.path(RECORDS))?.0;
+    let report = ShardReport {
+        shard: share.spec,
+        units: share.units.len(),
+        alternatives: share.units.iter().map(|&u| plan.units[u].count).sum(),
+        records: tally.records,
+        cost: plan.cost(share.units),
+        total_cost: plan.units.iter().map(|u| u.cost).sum(),
+        failed_models: ev.failed,
+        timings: Timings {
+            enumerate_s: plan.enumerate_s,
+            compile_s: ev.compile_s,
+            optimize_s: tally.optimize_ms / 1e3 + 0.0,
+            check_s: tally.check_ms / 1e3 + 0.0,
+            export_s: 0.0,
+            total_s: start.elapsed().as_secs_f64(),
+            cpu_s: crate::cpu_time::process_seconds(),
+        },
     };
-    let finished: std::collections::HashSet<String> = done.iter().map(|r| r.key.clone()).collect();
-    let todo: Vec<&Alternative> = alternatives
+    out.write(
+        SHARD_REPORT,
+        serde_json::to_string_pretty(&report).unwrap_or_default() + "\n",
+    )?;
+    Ok(report)
+}
+
+/// Evaluate every alternative of `units` not yet in `OUT/alternatives.jsonl` (with
+/// `resume`, the records of an earlier run of the same settings are kept), streaming
+/// each record to the file as it finishes.
+///
+/// Work goes by unit: a worker builds and compiles a unit's model, its alternatives are
+/// evaluated (in parallel), and the model is dropped when they are done. Memory holds
+/// the models in flight (about one per worker), not one per unit.
+pub fn evaluate_units(
+    task: &Task,
+    plan: &Plan,
+    units: &[usize],
+    out: &OutputDir,
+    resume: bool,
+    opts: &SearchOptions,
+    progress: &Progress,
+) -> Result<Evaluation, SearchError> {
+    let mut mine = vec![false; plan.units.len()];
+    for &u in units {
+        mine[u] = true;
+    }
+    let mut done = Done::new(plan.alternatives);
+    let (records_file, report) = output::keep_records(out, resume, &mut |r| {
+        let place = plan
+            .locate(&r.key)
+            .filter(|p| mine[p.unit])
+            .ok_or_else(|| {
+                format!(
+                    "alternative {} is not part of this search",
+                    crate::text::excerpt(&r.key, 200)
+                )
+            })?;
+        if done.insert(place.index) {
+            Ok(())
+        } else {
+            Err(format!(
+                "alternative {} appears again",
+                crate::text::excerpt(&r.key, 200)
+            ))
+        }
+    })?;
+    if let Some(report) = &report {
+        eprintln!("{}", report.text(&out.path(RECORDS)));
+    }
+    // The units with work left; their modes are listed when a worker takes them up.
+    let done = &done;
+    let undone = move |u: usize| {
+        let unit = &plan.units[u];
+        (0..unit.count as u32).filter(move |&m| !done.contains(unit.first + u64::from(m)))
+    };
+    let todo: Vec<usize> = units
         .iter()
-        .filter(|a| !finished.contains(&a.key()))
+        .copied()
+        .filter(|&u| undone(u).next().is_some())
         .collect();
-    // Rewrite the file with the kept records, then append as alternatives finish.
-    let (_, records_file) = output::write_records(&out, &done)?;
+    let remaining: usize = todo.iter().map(|&u| undone(u).count()).sum();
     let writer = Mutex::new(records_file);
     let write_error: Mutex<Option<std::io::Error>> = Mutex::new(None);
-
-    // One model per (graph, candidate), compiled by the first worker that needs it and
-    // dropped after its last alternative: memory stays bounded by the models in flight.
-    let mut pending = vec![0usize; graphs.len() * 3];
-    for a in &todo {
-        pending[a.graph * 3 + a.candidate] += 1;
-    }
-    let cache: Vec<Mutex<Slot>> = pending
-        .into_iter()
-        .map(|remaining| {
-            Mutex::new(Slot {
-                model: None,
-                seconds: 0.0,
-                remaining,
-                reported: false,
-            })
-        })
-        .collect();
+    let compile_s = Mutex::new(0.0f64);
+    let failed: Mutex<Vec<FailedModel>> = Mutex::new(Vec::new());
     let robust_spec = (!opts.post_check_only).then(|| RobustSpec::from_task(task, opts.sweep));
     progress.phase(
         "compile + optimize + check",
         "alternatives",
-        Some(todo.len() as u64),
+        Some(remaining as u64),
     );
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
         .build()
-        .map_err(|e| terr(&e.to_string()))?;
-    let new: Vec<AlternativeRecord> = pool.install(|| {
-        todo.par_iter()
-            .filter_map(|alt| {
-                let slot = &cache[alt.graph * 3 + alt.candidate];
-                let (prepared, first_failure) = {
-                    // Held while compiling: the other workers of this slot wait for it.
-                    let mut s = slot.lock().unwrap_or_else(|e| e.into_inner());
-                    if s.model.is_none() {
-                        let t = Stopwatch::start();
-                        s.model = Some(
-                            prepare(graphs[alt.graph], task, alt.candidate, robust_spec.as_ref())
-                                .map(Arc::new),
-                        );
-                        s.seconds += t.cpu_ms() / 1e3;
-                    }
-                    let m = s
-                        .model
-                        .clone()
-                        .unwrap_or_else(|| Err("not compiled".into()));
-                    let first = m.is_err() && !std::mem::replace(&mut s.reported, true);
-                    (m, first)
-                };
-                let release = || {
-                    let mut s = slot.lock().unwrap_or_else(|e| e.into_inner());
-                    s.remaining = s.remaining.saturating_sub(1);
-                    if s.remaining == 0 {
-                        // Keep a failure (cheap, and said once); drop the native code.
-                        if matches!(s.model, Some(Ok(_))) {
-                            s.model = None;
-                        }
-                    }
-                };
-                let prepared = match prepared {
-                    Ok(p) => p,
-                    Err(e) => {
-                        if first_failure {
-                            eprintln!(
-                                "error: {} (candidate {}): {e}",
-                                alt.sequence,
-                                alt.candidate + 1
-                            );
-                        }
-                        release();
-                        progress.inc(1);
-                        return None;
-                    }
-                };
-                let rec = evaluate(task, &prepared, alt, graphs[alt.graph], opts);
-                release();
-                let line = serde_json::to_string(&rec).unwrap_or_default();
+        .map_err(|e| SearchError::Task {
+            task: task.name.clone(),
+            message: e.to_string(),
+        })?;
+    let lock = |m: &Mutex<f64>| *m.lock().unwrap_or_else(|e| e.into_inner());
+    pool.install(|| {
+        todo.par_iter().for_each(|&u| {
+            let unit = &plan.units[u];
+            let modes: Vec<u32> = undone(u).collect();
+            let graph = plan.graph(task, unit.graph);
+            let t = Stopwatch::start();
+            let prepared = prepare(&graph, task, unit.candidate, robust_spec.as_ref());
+            *compile_s.lock().unwrap_or_else(|e| e.into_inner()) += t.cpu_ms() / 1e3;
+            let prepared = match prepared {
+                Ok(p) => p,
+                Err(error) => {
+                    let sequence = plan.graphs[unit.graph].sequence.clone();
+                    eprintln!(
+                        "error: {sequence} (candidate {}): {error}",
+                        unit.candidate + 1
+                    );
+                    failed
+                        .lock()
+                        .unwrap_or_else(|e| e.into_inner())
+                        .push(FailedModel {
+                            sequence,
+                            candidate: unit.candidate + 1,
+                            error,
+                        });
+                    progress.inc(modes.len() as u64);
+                    return;
+                }
+            };
+            modes.par_iter().for_each(|&m| {
+                let alt = plan.alternative(u, m);
+                let rec = evaluate(task, &prepared, &alt, &graph, opts);
+                let mut line = serde_json::to_string(&rec).unwrap_or_default();
+                line.push('\n');
                 if let Ok(mut w) = writer.lock() {
-                    // Each line is flushed as it is written: a kill loses at most this one.
-                    if let Err(e) = writeln!(w, "{line}").and_then(|_| w.flush())
+                    // One write per line, flushed: a kill loses at most this one.
+                    if let Err(e) = w.write_all(line.as_bytes()).and_then(|_| w.flush())
                         && let Ok(mut first) = write_error.lock()
                     {
                         first.get_or_insert(e);
                     }
                 }
                 progress.inc(1);
-                Some(rec)
-            })
-            .collect()
+            });
+            // `prepared` (the native code) is dropped here, with its last alternative.
+        });
     });
     progress.finish_phase();
     if let Some(e) = write_error.into_inner().ok().flatten() {
@@ -743,123 +859,174 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
             source: e,
         });
     }
+    let mut failed = failed.into_inner().unwrap_or_else(|e| e.into_inner());
+    failed.sort_by(|a, b| (&a.sequence, a.candidate).cmp(&(&b.sequence, b.candidate)));
+    Ok(Evaluation {
+        compile_s: lock(&compile_s) + 0.0,
+        jobs: pool.current_num_threads(),
+        resumed: report.as_ref().map_or(0, |r| r.reused),
+        resume: report,
+        failed,
+    })
+}
 
-    let mut records = done;
-    records.extend(new);
-    let order: HashMap<String, usize> = wanted;
-    records.sort_by_key(|r| order.get(&r.key).copied().unwrap_or(usize::MAX));
+/// Read a records file line by line: the summary's counts, and where each feasible
+/// design's record is (its alternative number and the byte offset of its line), most
+/// robust first (ties: enumeration order).
+pub fn tally_records(plan: &Plan, path: &Path) -> Result<(Tally, Vec<(u64, u64)>), SearchError> {
+    let io = |source| SearchError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let mut reader = BufReader::new(File::open(path).map_err(io)?);
+    let mut tally = Tally::default();
+    let mut designs = Vec::new();
+    let mut buf = String::new();
+    let mut offset = 0u64;
+    let mut line = 0usize;
+    loop {
+        buf.clear();
+        let n = reader.read_line(&mut buf).map_err(io)?;
+        if n == 0 {
+            break;
+        }
+        line += 1;
+        let bad = |why: String| SearchError::Records {
+            path: path.display().to_string(),
+            line,
+            message: why,
+        };
+        let rec: AlternativeRecord =
+            serde_json::from_str(&buf).map_err(|e| bad(format!("not a record ({e})")))?;
+        tally.add(&rec);
+        if rec.feasible_design() {
+            let place = plan
+                .locate(&rec.key)
+                .ok_or_else(|| bad(format!("{} is not an alternative of this search", rec.key)))?;
+            designs.push((rec.score(), place.index, offset));
+        }
+        offset += n as u64;
+    }
+    // Most robust first (ties: enumeration order).
+    designs.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    Ok((tally, designs.into_iter().map(|(_, i, o)| (i, o)).collect()))
+}
 
-    // `+ 0.0`: an empty f64 sum is −0.0, which would print as "-0.00 s".
-    let compile_s: f64 = cache
-        .iter()
-        .map(|c| c.lock().map_or(0.0, |s| s.seconds))
-        .sum::<f64>()
-        + 0.0;
+/// Summarize the records in `OUT/alternatives.jsonl` and write `summary.json`, the
+/// designs and (with export) their files and the report. `start` is when the run began.
+pub fn finish(
+    task: &Task,
+    plan: &Plan,
+    out: &OutputDir,
+    opts: &SearchOptions,
+    ev: &Evaluation,
+    start: Instant,
+    progress: &Progress,
+) -> Result<Summary, SearchError> {
+    let records = out.path(RECORDS);
+    let (tally, designs) = tally_records(plan, &records)?;
     let mut timings = Timings {
-        enumerate_s,
-        compile_s,
-        optimize_s: records.iter().map(|r| r.optimize_ms).sum::<f64>() / 1e3 + 0.0,
-        check_s: records.iter().map(|r| r.check_ms).sum::<f64>() / 1e3 + 0.0,
+        enumerate_s: plan.enumerate_s,
+        compile_s: ev.compile_s,
+        optimize_s: tally.optimize_ms / 1e3 + 0.0,
+        check_s: tally.check_ms / 1e3 + 0.0,
         export_s: 0.0,
         total_s: 0.0,
         cpu_s: 0.0,
     };
-    let mut feasible: Vec<&AlternativeRecord> =
-        records.iter().filter(|r| r.feasible_design()).collect();
-    // Most robust first (ties: enumeration order).
-    feasible.sort_by(|a, b| b.score().total_cmp(&a.score()));
+    let mut ids = Vec::with_capacity(designs.len());
     let mut summary = Summary {
         task: task.name.clone(),
-        n_max,
-        graphs: graphs.len(),
-        alternatives: records.len(),
-        meets_target: records.iter().filter(|r| r.meets_target).count(),
-        no_self_intersection: records
-            .iter()
-            .filter(|r| r.meets_target && r.self_intersection_free == Some(true))
-            .count(),
-        no_intersection: records.iter().filter(|r| r.thesis_feasible()).count(),
-        feasible: feasible.len(),
-        rigid_at_tmax_only: records
-            .iter()
-            .filter(|r| {
-                r.meets_target
-                    && r.verification
-                        .as_ref()
-                        .is_some_and(|v| v.rigid_at_tmax && !v.rigid_over_motion)
-            })
-            .count(),
-        verification_failures: records
-            .iter()
-            .filter(|r| r.verification_failed == Some(true))
-            .count(),
-        thesis: if n_max == 3 {
+        n_max: plan.n_max,
+        graphs: plan.graphs.len(),
+        alternatives: tally.records,
+        meets_target: tally.meets_target,
+        no_self_intersection: tally.no_self_intersection,
+        no_intersection: tally.no_intersection,
+        feasible: tally.feasible,
+        rigid_at_tmax_only: tally.rigid_at_tmax_only,
+        verification_failures: tally.verification_failures,
+        thesis: if plan.n_max == 3 {
             Summary::thesis_counts(&task.name)
         } else {
             None
         },
         timings: timings.clone(),
-        levels: level_distribution(&records),
+        levels: tally.levels,
         settings: json!({
-            "starts": opts.starts, "seed": opts.seed, "jobs": pool.current_num_threads(),
-            "sweep": opts.sweep, "resumed": finished.len(), "resume": resume,
+            "starts": opts.starts, "seed": opts.seed, "jobs": ev.jobs,
+            "sweep": opts.sweep, "resumed": ev.resumed, "resume": ev.resume,
             "post_check_only": opts.post_check_only,
-            "optimize_states": robust_spec.as_ref().map(|s| s.states),
+            "optimize_states": (!opts.post_check_only)
+                .then(|| RobustSpec::from_task(task, opts.sweep).states),
             "robustness": {
                 "rigid_margin": task.robustness.rigid_margin,
                 "clearance": task.robustness.clearance,
                 "obstacle_clearance": task.robustness.obstacle_clearance,
             },
         }),
-        meets_margins: feasible
-            .iter()
-            .filter(|r| r.robustness.as_ref().is_some_and(|x| x.meets_settings()))
-            .count(),
-        near_rigid_limit: feasible
-            .iter()
-            .filter(|r| {
-                r.robustness
-                    .as_ref()
-                    .is_some_and(|x| x.rigid_margin.value < 1e-3)
-            })
-            .count(),
-        ranking: feasible
-            .iter()
-            .map(|r| RankEntry {
-                id: r.id(),
-                score: r.robustness.as_ref().map(|x| x.score),
-            })
-            .collect(),
-        designs: feasible.iter().map(|r| r.id()).collect(),
+        meets_margins: tally.meets_margins,
+        near_rigid_limit: tally.near_rigid_limit,
+        ranking: Vec::new(),
+        designs: Vec::new(),
         cyclic: opts.rules.r2p.then(|| {
-            CyclicCounts::count(
-                graphs.iter().filter(|g| g.is_cyclic_pattern()).count(),
-                &records,
-            )
+            let mut c = tally.cyclic.clone();
+            c.graphs = plan.cyclic_graphs;
+            c
         }),
     };
+    // The ids and scores, most robust first (the order of `designs`), from the records.
+    let mut ranking = Vec::with_capacity(designs.len());
+    for chunk in designs.chunks(1024) {
+        for rec in read_at(&records, chunk)? {
+            ids.push(rec.id());
+            ranking.push(RankEntry {
+                id: rec.id(),
+                score: rec.robustness.as_ref().map(|x| x.score),
+            });
+        }
+    }
+    summary.designs = ids;
+    summary.ranking = ranking;
 
     let t2 = Instant::now();
     summary.timings.total_s = start.elapsed().as_secs_f64();
     write_designs(
-        task,
-        &graphs,
-        &enumeration,
-        &feasible,
-        &summary,
-        opts,
-        &progress,
-        &out,
+        task, plan, &records, &designs, &summary, opts, out, progress,
     )?;
     timings.export_s = t2.elapsed().as_secs_f64();
     timings.total_s = start.elapsed().as_secs_f64();
-    timings.cpu_s = crate::cpu_time::process_seconds() - cpu0;
+    // A run (or a merge) is one process: its CPU time so far.
+    timings.cpu_s = crate::cpu_time::process_seconds();
     summary.timings = timings;
     out.write(
         "summary.json",
         serde_json::to_string_pretty(&summary).unwrap_or_default(),
     )?;
     Ok(summary)
+}
+
+/// The records at `places` (alternative number, byte offset) of the records file.
+fn read_at(path: &Path, places: &[(u64, u64)]) -> Result<Vec<AlternativeRecord>, SearchError> {
+    let io = |source| SearchError::Io {
+        path: path.display().to_string(),
+        source,
+    };
+    let mut reader = BufReader::new(File::open(path).map_err(io)?);
+    let mut buf = String::new();
+    places
+        .iter()
+        .map(|&(_, offset)| {
+            reader.seek(SeekFrom::Start(offset)).map_err(io)?;
+            buf.clear();
+            reader.read_line(&mut buf).map_err(io)?;
+            serde_json::from_str(&buf).map_err(|e| SearchError::Records {
+                path: path.display().to_string(),
+                line: 0,
+                message: format!("the record at byte {offset} is not readable any more ({e})"),
+            })
+        })
+        .collect()
 }
 
 /// The export metadata of a design.
@@ -919,18 +1086,119 @@ pub fn model_meta(task: &Task, model: &Model, modes: &[String], objective: f64) 
 #[allow(clippy::too_many_arguments)]
 fn write_designs(
     task: &Task,
-    graphs: &[&CreaseGraph],
-    enumeration: &Enumeration,
-    feasible: &[&AlternativeRecord],
+    plan: &Plan,
+    records: &Path,
+    feasible: &[(u64, u64)],
     summary: &Summary,
     opts: &SearchOptions,
-    progress: &Progress,
     out_dir: &OutputDir,
+    progress: &Progress,
 ) -> Result<(), SearchError> {
     // The earlier run's designs were deleted when the directory was opened (only the
     // files its manifest lists).
     out_dir.create_dir("designs")?;
-    // Designs are independent: write them in parallel, keep the cards in order.
+    // Designs are independent: built and written in parallel, a chunk at a time (memory
+    // holds one chunk); each chunk's files are listed in the manifest in one step before
+    // any is written. The cards stay in the order of `feasible`: most robust first, `rank`
+    // 1.
+    let build = |(rank, rec): (usize, &AlternativeRecord)| -> Result<DesignWork, SearchError> {
+        let (model, free, full, modes) = design_of(task, &plan.graph(task, rec.graph), rec)?;
+        let design = Evaluated::new(&model.plan, full.clone(), modes);
+        let pattern = design.pattern(&sample_times(model.t_max, 33));
+        let meta = design_meta(task, &model, rec);
+        let all_vars: BTreeMap<String, f64> = model
+            .plan
+            .variables
+            .iter()
+            .zip(&full)
+            .map(|(v, x)| (v.name.clone(), *x))
+            .collect();
+        let constraints: Vec<_> = {
+            let (_, g) = crate::model::compiled::outputs_f64(&model, &free, &design.modes);
+            g.iter()
+                .enumerate()
+                .map(|(k, v)| json!({"label": model.constraint_label(k), "value": v}))
+                .collect()
+        };
+        let id = rec.id();
+        let doc = json!({
+            "id": id,
+            "task": task.name,
+            "sequence": rec.sequence,
+            "level": rec.level,
+            "candidate": rec.candidate,
+            "gripping_vertex": rec.gripping_vertex,
+            "modes": rec.modes,
+            "objective": rec.objective,
+            "threshold": model.threshold,
+            "variables": rec.variables,
+            "all_variables": all_vars,
+            "constraint_slack": rec.min_slack,
+            "constraints": constraints,
+            "verification": rec.verification,
+            "self_intersection_free": rec.self_intersection_free,
+            "obstacle_free": rec.obstacle_free,
+            "robustness": rec.robustness,
+            "rank": rank,
+            "pattern": pattern,
+            "meta": meta,
+            "svg": export::svg::svg_scale(&pattern, &Default::default()).ok(),
+        });
+        Ok(DesignWork {
+            rec: rec.clone(),
+            threshold: model.threshold,
+            doc: serde_json::to_string_pretty(&doc).unwrap_or_default(),
+            options: ExportOptions {
+                name: id.clone(),
+                ..Default::default()
+            },
+            id,
+            pattern,
+            meta,
+        })
+    };
+    let write_one = |w: DesignWork| -> Result<export::report::ReportDesign, SearchError> {
+        let id = &w.id;
+        let path = out_dir.path(&format!("designs/{id}.json"));
+        std::fs::write(&path, &w.doc).map_err(|source| SearchError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        if !opts.export {
+            progress.inc(1);
+            return Ok(report_design(
+                &w.rec,
+                w.threshold,
+                w.pattern,
+                w.meta,
+                path,
+                None,
+                None,
+            ));
+        }
+        let out = out_dir.path(&format!("designs/{id}"));
+        let files = export::write_all(&out, &w.pattern, &w.meta, &w.options)
+            .map_err(|e| SearchError::Export(e.to_string()))?;
+        let check = export::verify::verify_file(&files.fold, &Default::default())
+            .map_err(|e| SearchError::Export(e.to_string()))?;
+        if !check.ok {
+            eprintln!("BUG: the exported FOLD file of {id} fails verification");
+        }
+        progress.inc(1);
+        Ok(report_design(
+            &w.rec,
+            w.threshold,
+            w.pattern,
+            w.meta,
+            path,
+            Some(files),
+            Some(check),
+        ))
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.jobs)
+        .build()
+        .map_err(|e| SearchError::Export(e.to_string()))?;
     progress.phase(
         if opts.export {
             "write designs and their files"
@@ -940,106 +1208,38 @@ fn write_designs(
         "designs",
         Some(feasible.len() as u64),
     );
-    let write_one = |(rank, rec): (usize, &&AlternativeRecord)| -> Result<export::report::ReportDesign, SearchError> {
-            let rank = rank + 1;
-            let (model, free, full, modes) = design_of(task, graphs[rec.graph], rec)?;
-            let design = Evaluated::new(&model.plan, full.clone(), modes);
-            let pattern = design.pattern(&sample_times(model.t_max, 33));
-            let meta = design_meta(task, &model, rec);
-            let all_vars: BTreeMap<String, f64> = model
-                .plan
-                .variables
-                .iter()
-                .zip(&full)
-                .map(|(v, x)| (v.name.clone(), *x))
-                .collect();
-            let constraints: Vec<_> = {
-                let (_, g) = crate::model::compiled::outputs_f64(&model, &free, &design.modes);
-                g.iter()
-                    .enumerate()
-                    .map(|(k, v)| json!({"label": model.constraint_label(k), "value": v}))
-                    .collect()
-            };
-            let id = rec.id();
-            let doc = json!({
-                "id": id,
-                "task": task.name,
-                "sequence": rec.sequence,
-                "level": rec.level,
-                "candidate": rec.candidate,
-                "gripping_vertex": rec.gripping_vertex,
-                "modes": rec.modes,
-                "objective": rec.objective,
-                "threshold": model.threshold,
-                "variables": rec.variables,
-                "all_variables": all_vars,
-                "constraint_slack": rec.min_slack,
-                "constraints": constraints,
-                "verification": rec.verification,
-                "self_intersection_free": rec.self_intersection_free,
-                "obstacle_free": rec.obstacle_free,
-                "robustness": rec.robustness,
-                "rank": rank,
-                "pattern": pattern,
-                "meta": meta,
-                "svg": export::svg::svg_scale(&pattern, &Default::default()).ok(),
-            });
-            let path = out_dir.write(
-                &format!("designs/{id}.json"),
-                serde_json::to_string_pretty(&doc).unwrap_or_default(),
-            )?;
-            if !opts.export {
-                progress.inc(1);
-                return Ok(report_design(
-                    rec,
-                    model.threshold,
-                    pattern,
-                    meta,
-                    path,
-                    None,
-                    None,
-                ));
+    let mut cards: Vec<export::report::ReportDesign> = Vec::new();
+    for (c, chunk) in feasible.chunks(256).enumerate() {
+        let recs = read_at(records, chunk)?;
+        let work = pool.install(|| {
+            recs.par_iter()
+                .enumerate()
+                .map(|(k, rec)| build((c * 256 + k + 1, rec)))
+                .collect::<Result<Vec<_>, _>>()
+        })?;
+        // Listed before they are written, so a kill leaves nothing unlisted.
+        let mut files: Vec<PathBuf> = work
+            .iter()
+            .map(|w| out_dir.path(&format!("designs/{}.json", w.id)))
+            .collect();
+        if opts.export {
+            let dirs: Vec<String> = work.iter().map(|w| format!("designs/{}", w.id)).collect();
+            for (w, dir) in work.iter().zip(out_dir.create_dirs(&dirs)?) {
+                files.extend(export::planned_files(&dir, &w.pattern, &w.options).all());
             }
-            let out = out_dir.create_dir(&format!("designs/{id}"))?;
-            let eo = ExportOptions {
-                name: id.clone(),
-                ..Default::default()
-            };
-            // Listed before they are written, so a kill leaves nothing unlisted.
-            out_dir.register(export::planned_files(&out, &pattern, &eo).all())?;
-            let files = export::write_all(&out, &pattern, &meta, &eo)
-                .map_err(|e| SearchError::Export(e.to_string()))?;
-            let check = export::verify::verify_file(&files.fold, &Default::default())
-                .map_err(|e| SearchError::Export(e.to_string()))?;
-            if !check.ok {
-                eprintln!("BUG: the exported FOLD file of {id} fails verification");
-            }
-            progress.inc(1);
-            Ok(report_design(
-                rec,
-                model.threshold,
-                pattern,
-                meta,
-                path,
-                Some(files),
-                Some(check),
-            ))
-        };
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.jobs)
-        .build()
-        .map_err(|e| SearchError::Export(e.to_string()))?;
-    let cards: Vec<export::report::ReportDesign> = pool.install(|| {
-        feasible
-            .par_iter()
-            .enumerate()
-            .map(write_one)
-            .collect::<Result<Vec<_>, _>>()
-    })?;
+        }
+        out_dir.register(&files)?;
+        let written = pool.install(|| {
+            work.into_par_iter()
+                .map(write_one)
+                .collect::<Result<Vec<_>, _>>()
+        })?;
+        cards.extend(written);
+    }
     progress.phase("write report", "", None);
     let input = report_input(
         task,
-        enumeration,
+        plan.tree.clone(),
         summary,
         task_facts(task, opts, summary),
         cards,
@@ -1050,4 +1250,16 @@ fn write_designs(
     let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
     progress.finish_phase_with(&format!("{} ({bytes} bytes)", path.display()));
     Ok(())
+}
+
+/// One design, built and ready to write.
+struct DesignWork {
+    id: String,
+    rec: AlternativeRecord,
+    threshold: f64,
+    /// `designs/<id>.json`.
+    doc: String,
+    pattern: Pattern,
+    meta: DesignMeta,
+    options: ExportOptions,
 }

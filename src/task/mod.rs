@@ -620,7 +620,7 @@ fn check_name(name: &str) -> Result<(), String> {
 }
 
 /// FNV-1a (64 bits) of `bytes`, as 16 hex digits: enough to notice an edited file.
-fn digest(bytes: &[u8]) -> String {
+pub fn digest(bytes: &[u8]) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for b in bytes {
         h = (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
