@@ -313,6 +313,10 @@ impl Pairs {
                             va.iter().map(|v| arm(*v)).collect(),
                             vb.iter().map(|v| cpy(*v)).collect(),
                         ),
+                        // The tips are the apex, as a shared vertex is: left out. Kept,
+                        // each would constrain the direction of its offset from the
+                        // midpoint, which vanishes on every design that meets its target:
+                        // `|x − apex|` has its kink there.
                         ([], Some(g)) => push(
                             (i, false),
                             Some((j, true)),
@@ -321,8 +325,8 @@ impl Pairs {
                                 b: cpy(g),
                             },
                             Group::Arm,
-                            va.iter().map(|v| arm(*v)).collect(),
-                            vb.iter().map(|v| cpy(*v)).collect(),
+                            without(va, g, &arm),
+                            without(vb, g, &cpy),
                         ),
                         ([(a, q)], None) => push(
                             (i, false),
