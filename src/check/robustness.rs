@@ -343,7 +343,7 @@ pub fn measure(input: &RobustnessInput<'_>) -> Result<RobustnessReport, CheckErr
             value: f.value,
             setting: s.min_feature,
             t: Some(0.0),
-            location: feature_location(&f.kind, &vname),
+            location: feature_location(&f.kind, vname),
         }),
     };
     report.score = score(&report);
