@@ -146,7 +146,7 @@ fn facts(g: &ExprGraph, id: NodeId, info: &[Info]) -> Info {
     let z = |c: NodeId| of(c).zero.as_ref();
     let f = |c: NodeId| of(c).fin.as_ref();
     let zero = match node {
-        Const(c) if c == 0.0 => Some(Set::new()),
+        Const(c) => (c == 0.0).then(Set::new),
         Mul(a, b) => join(z(a), f(b)).or_else(|| join(z(b), f(a))),
         Sub(a, b) if a == b => f(a).cloned(),
         Add(a, b) | Sub(a, b) => join(z(a), z(b)),

@@ -601,7 +601,7 @@ mod tests {
             let r = Range::plus_abs(&x);
             assert!(got >= r.lo && got <= r.hi, "{v}: {got}");
             let a = v * sgn_f64(v);
-            assert!(a >= 0.0 && a <= 3.0, "{v}: {a}");
+            assert!((0.0..=3.0).contains(&a), "{v}: {a}");
         }
         // 2x may overflow: finite but unbounded x gives nothing, nor does an unknown x.
         assert!(!Range::plus_abs(&Range::FINITE).finite);
