@@ -13,7 +13,8 @@
 //!   spherical polygons they cut from the unit sphere around it; 0 when those overlap),
 //!   reported as the chord `2 sin(θ/2)`, the gap at unit distance from the vertex; the
 //!   same about the midpoint of the two tips for the facets of a two-armed gripper's tips,
-//!   which meet at the target by design;
+//!   which meet at the target by design (the tips are that apex: the cones are spanned by
+//!   the facets' other vertices);
 //! - facets sharing a crease: `2 sin((π − |ρ|)/2)` with the fold angle measured from the
 //!   two facets' geometry (the flip test's angle);
 //! - a facet and a cylinder: the triangle–segment distance to the axis minus the radius
@@ -286,7 +287,16 @@ pub fn measure(input: &RobustnessInput<'_>) -> Result<RobustnessReport, CheckErr
                 }
                 Relation::Tip => {
                     let (g, c) = input.tip.expect("tip pairs need the tips");
-                    let theta = cone_angle((x[g] + x[c]) * 0.5, &pat.faces[fa], &pat.faces[fb], &x);
+                    // The tips are the apex (within the target's tolerance of it): the
+                    // cones are those of the faces' other vertices.
+                    let other = |f: usize| -> Vec<usize> {
+                        pat.faces[f]
+                            .iter()
+                            .copied()
+                            .filter(|v| *v != g && *v != c)
+                            .collect()
+                    };
+                    let theta = cone_angle((x[g] + x[c]) * 0.5, &other(fa), &other(fb), &x);
                     let chord = 2.0 * (0.5 * theta).sin();
                     least.offer(chord, t, || {
                         format!("facets {}–{} at the tips", face_name(fa), face_name(fb))

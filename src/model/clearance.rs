@@ -23,7 +23,9 @@
 //!   two-armed task whose arms grip the target together, the midpoint of the two tips
 //!   (they meet there at the target). The plane passes through that apex and every other
 //!   vertex keeps `n·(x − apex) ≥ (G/2)|x − apex|`, so the facets' cones at the apex are
-//!   an angle `2 asin(G/2)` apart (a chord of at least G at unit distance from it);
+//!   an angle `2 asin(G/2)` apart (a chord of at least G at unit distance from it); the
+//!   two tips themselves, within the target's tolerance of their midpoint, only keep to
+//!   their sides (`±n·(x − apex) ≥ 0`, smooth where the angular form has a kink);
 //! - facets sharing a crease: its fold angle stays `2 asin(G/2)` short of ±π (the model's
 //!   crease constraints, not here);
 //! - a facet and a cylinder ([`PairKind::Obstacle`]): the facet clear of the capsule of
@@ -313,6 +315,8 @@ impl Pairs {
                             va.iter().map(|v| arm(*v)).collect(),
                             vb.iter().map(|v| cpy(*v)).collect(),
                         ),
+                        // The tips stay in the lists: each keeps to its side of the plane
+                        // (see `constraints`), or the facets cross within the tips' offset.
                         ([], Some(g)) => push(
                             (i, false),
                             Some((j, true)),
@@ -829,17 +833,29 @@ pub fn constraints(
             for (k, r) in pair.a_verts.iter().chain(&pair.b_verts).enumerate() {
                 let sign = if k < pair.a_verts.len() { 1.0 } else { -1.0 };
                 let d = sub(s.at(*r), apex);
-                let len = norm(d);
-                let inv = if len > 0.0 { 1.0 / len } else { 0.0 };
-                let g = [
-                    sign * n[0] - ga * d[0] * inv,
-                    sign * n[1] - ga * d[1] * inv,
-                    sign * n[2] - ga * d[2] * inv,
-                ];
+                // A tip of a gripper's two arms (the apex is their midpoint) only keeps to
+                // its side, `±n·d ≥ 0`: its offset d from the apex vanishes on every design
+                // that meets its target, where the angular gap `(G/2)|d|` has its kink.
+                // With every other vertex strictly inside its cone, each facet stays in its
+                // closed half-space: they can touch at the tips, never cross.
+                let (h, g) = if *r == a || *r == b {
+                    (sign * dot(n, d), scale(n, sign))
+                } else {
+                    let len = norm(d);
+                    let inv = if len > 0.0 { 1.0 / len } else { 0.0 };
+                    (
+                        sign * dot(n, d) - ga * len,
+                        [
+                            sign * n[0] - ga * d[0] * inv,
+                            sign * n[1] - ga * d[1] * inv,
+                            sign * n[2] - ga * d[2] * inv,
+                        ],
+                    )
+                };
                 let m = scale(g, -0.5);
                 visit(Slot {
                     slot: pair.slot + k,
-                    h: sign * dot(n, d) - ga * len,
+                    h,
                     dx: &[(*r, g), (a, m), (b, m)],
                     dn: scale(d, sign),
                     dd: 0.0,

@@ -62,6 +62,10 @@ pub struct AlternativeRecord {
     /// for alternatives that meet the target.
     #[serde(default)]
     pub robustness: Option<RobustnessReport>,
+    /// Why an alternative that passes every check is not a design: the required margins
+    /// short of their settings on the sweep ([`AlternativeRecord::margins_short`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub short_of_margins: Vec<String>,
     /// Free variables at the optimum by name.
     pub variables: BTreeMap<String, f64>,
     /// Starting points run.
@@ -87,9 +91,9 @@ impl AlternativeRecord {
             && self.obstacle_free == Some(true)
     }
 
-    /// Thesis-feasible and, in addition, rigid over the whole motion and verified: what
-    /// foldsynth reports as a feasible design.
-    pub fn feasible_design(&self) -> bool {
+    /// Thesis-feasible and, in addition, rigid over the whole motion and verified (the
+    /// checks alone, whatever the margins).
+    pub fn passes_checks(&self) -> bool {
         self.thesis_feasible()
             && self
                 .verification
@@ -97,6 +101,57 @@ impl AlternativeRecord {
                 .is_some_and(|v| v.rigid_over_motion)
             && self.verification_failed == Some(false)
             && self.cycle.as_ref().is_none_or(|c| c.passes)
+    }
+
+    /// Whether the margins the run requires hold on the sweep. With the robustness
+    /// constraints on (not `--post-check-only`) and some margin set, every margin measured
+    /// by `check::robustness` must be at least its setting (a design whose measurement
+    /// failed cannot show that); with `--post-check-only` or every setting 0 (the thesis's
+    /// setting) the margins are reported, not required.
+    pub fn margins_hold(&self) -> bool {
+        if self.robust_accepted.is_none() {
+            return true;
+        }
+        self.robustness
+            .as_ref()
+            .is_some_and(|r| r.margins().all(|m| m.setting == 0.0) || r.meets_settings())
+    }
+
+    /// The required margins short of their setting on the sweep (see
+    /// [`AlternativeRecord::margins_hold`]), e.g. `obstacle_clearance 0.0071 < 0.01 at t
+    /// 1.2 (facet f3 ↔ cylinder 1)`; empty when they hold or are not required.
+    pub fn margins_short(&self) -> Vec<String> {
+        if self.margins_hold() {
+            return Vec::new();
+        }
+        let Some(r) = &self.robustness else {
+            return vec!["the robustness measurement failed".into()];
+        };
+        let named = [
+            ("rigid_margin", Some(&r.rigid_margin)),
+            ("self_clearance", r.self_clearance.as_ref()),
+            ("arm_clearance", r.arm_clearance.as_ref()),
+            ("obstacle_clearance", r.obstacle_clearance.as_ref()),
+            ("min_feature", r.min_feature.as_ref()),
+        ];
+        named
+            .into_iter()
+            .filter_map(|(name, m)| m.map(|m| (name, m)))
+            .filter(|(_, m)| m.value < m.setting)
+            .map(|(name, m)| {
+                let at = m.t.map(|t| format!(" at t {t:.4}")).unwrap_or_default();
+                format!(
+                    "{name} {:.3e} < {:.3e}{at} ({})",
+                    m.value, m.setting, m.location
+                )
+            })
+            .collect()
+    }
+
+    /// Passes every check and keeps the margins the run requires: what foldsynth reports
+    /// as a feasible design.
+    pub fn feasible_design(&self) -> bool {
+        self.passes_checks() && self.margins_hold()
     }
 
     /// Whether the design comes from a cyclic graph (an r2′ step in its sequence).
@@ -196,6 +251,8 @@ pub struct Tally {
     pub meets_margins: usize,
     /// Feasible designs within 1e-3 of the rigidity limit.
     pub near_rigid_limit: usize,
+    /// Alternatives that pass every check but are short of a required margin (not designs).
+    pub short_of_margins: usize,
     /// The records from cyclic graphs (r2′); `graphs` is left 0.
     pub cyclic: CyclicCounts,
 }
@@ -209,6 +266,7 @@ impl Tally {
         self.no_self_intersection += usize::from(no_self);
         self.no_intersection += usize::from(r.thesis_feasible());
         self.feasible += usize::from(r.feasible_design());
+        self.short_of_margins += usize::from(r.passes_checks() && !r.margins_hold());
         self.rigid_at_tmax_only += usize::from(
             r.meets_target
                 && r.verification
@@ -278,6 +336,10 @@ pub struct Summary {
     /// Feasible designs with a vertex within 1e-3 rad of its rigid limit.
     #[serde(default)]
     pub near_rigid_limit: usize,
+    /// Alternatives that pass every check but are short of a margin the run requires (with
+    /// the constraints on and a margin set): not counted as designs.
+    #[serde(default)]
+    pub short_of_margins: usize,
     /// The feasible designs, most robust first.
     #[serde(default)]
     pub ranking: Vec<RankEntry>,
@@ -400,6 +462,12 @@ impl Summary {
             "  … also rigid over the whole motion  {:>6}   (foldsynth's feasible designs)\n",
             self.feasible
         );
+        if self.short_of_margins > 0 {
+            s += &format!(
+                "  pass every check but short of a required margin (not designs): {}\n",
+                self.short_of_margins
+            );
+        }
         s += &format!(
             "  meet the target, rigid at t_max but not over the whole motion: {}\n",
             self.rigid_at_tmax_only

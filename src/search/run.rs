@@ -304,6 +304,7 @@ fn evaluate(
         robust_accepted: sol.robust,
         robust_attempts: sol.robust_attempts,
         robustness: None,
+        short_of_margins: Vec::new(),
         variables,
         starts_run: sol.starts_run,
         evaluations: sol.evaluations,
@@ -403,6 +404,9 @@ fn evaluate(
         rec.verification_failed = Some(failed);
     }
     rec.verification = Some(report);
+    if rec.passes_checks() {
+        rec.short_of_margins = rec.margins_short();
+    }
     rec.check_ms = t1.cpu_ms();
     rec
 }
@@ -969,6 +973,7 @@ pub fn finish(
         }),
         meets_margins: tally.meets_margins,
         near_rigid_limit: tally.near_rigid_limit,
+        short_of_margins: tally.short_of_margins,
         ranking: Vec::new(),
         designs: Vec::new(),
         cyclic: opts.rules.r2p.then(|| {
