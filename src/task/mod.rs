@@ -88,6 +88,9 @@ pub struct Task {
     /// Margins the optimizer keeps over the whole motion (`[robustness]`, defaults when
     /// absent).
     pub robustness: Robustness,
+    /// `[constraints] kawasaki = true`: every internal vertex of even degree folds flat
+    /// (Kawasaki's condition, imposed by the model); off when absent.
+    pub kawasaki: bool,
 }
 
 /// Symmetry of a design task.
@@ -182,6 +185,14 @@ struct RawTask {
     objective: Option<RawObjective>,
     check: Option<RawCheck>,
     robustness: Option<robustness::RawRobustness>,
+    constraints: Option<RawConstraints>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawConstraints {
+    #[serde(default)]
+    kawasaki: bool,
 }
 
 #[derive(Deserialize)]
@@ -593,6 +604,7 @@ impl Task {
             objective,
             check,
             robustness,
+            kawasaki: raw.constraints.is_some_and(|c| c.kawasaki),
         })
     }
 }
