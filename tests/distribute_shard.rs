@@ -9,6 +9,10 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+#[path = "common/runs.rs"]
+mod runs;
+use runs::{design_files, records, summary};
+
 const GRIPPER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper.toml");
 
 fn foldsynth(args: &[&str]) -> Output {
@@ -49,48 +53,6 @@ fn merge(dirs: &[PathBuf], out: &Path, extra: &[&str]) -> Output {
     args.extend(["--out", out.to_str().unwrap(), "--json", "--jobs", "2"]);
     args.extend(extra);
     foldsynth(&args)
-}
-
-/// The records of a run by key, without the timing fields.
-fn records(dir: &Path) -> BTreeMap<String, Value> {
-    let text = std::fs::read_to_string(dir.join("alternatives.jsonl")).unwrap_or_default();
-    text.lines()
-        .map(|l| {
-            let mut v: Value = serde_json::from_str(l).unwrap();
-            let m = v.as_object_mut().unwrap();
-            m.remove("optimize_ms");
-            m.remove("check_ms");
-            (m["key"].as_str().unwrap().to_string(), v)
-        })
-        .collect()
-}
-
-/// A summary without what depends on the machine and the moment: timings and workers.
-fn summary(dir: &Path) -> Value {
-    let mut s: Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    let m = s.as_object_mut().unwrap();
-    m.remove("timings");
-    m["settings"].as_object_mut().unwrap().remove("jobs");
-    s
-}
-
-/// Every file under `dir/designs`, relative path → bytes.
-fn design_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut out = BTreeMap::new();
-    let mut stack = vec![dir.join("designs")];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                stack.push(p);
-            } else {
-                let rel = p.strip_prefix(dir).unwrap().display().to_string();
-                out.insert(rel, std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    out
 }
 
 #[test]

@@ -10,12 +10,15 @@
 //! `.ci/run`) that is a failure instead. The daemons are stopped when the test ends, also
 //! when it fails (a guard's `Drop`).
 
-use serde_json::Value;
 use std::collections::BTreeMap;
 use std::os::unix::fs::PermissionsExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
+
+#[path = "common/runs.rs"]
+mod runs;
+use runs::{design_files, records, summary};
 
 const GRIPPER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper.toml");
 const CONF_IN: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/slurm/slurm.conf.in");
@@ -264,43 +267,6 @@ fn cluster_or_skip() -> Option<Cluster> {
             None
         }
     }
-}
-
-/// The records of a run by key, without the timing fields.
-fn records(dir: &Path) -> BTreeMap<String, Value> {
-    let text = std::fs::read_to_string(dir.join("alternatives.jsonl")).unwrap();
-    text.lines()
-        .map(|l| {
-            let mut v: Value = serde_json::from_str(l).unwrap();
-            let m = v.as_object_mut().unwrap();
-            m.remove("optimize_ms");
-            m.remove("check_ms");
-            (m["key"].as_str().unwrap().to_string(), v)
-        })
-        .collect()
-}
-
-/// A summary without timings and worker count.
-fn summary(dir: &Path) -> Value {
-    let mut s: Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    let m = s.as_object_mut().unwrap();
-    m.remove("timings");
-    m["settings"].as_object_mut().unwrap().remove("jobs");
-    s
-}
-
-fn design_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    std::fs::read_dir(dir.join("designs"))
-        .unwrap()
-        .map(|e| {
-            let p = e.unwrap().path();
-            (
-                p.file_name().unwrap().to_string_lossy().into_owned(),
-                std::fs::read(&p).unwrap(),
-            )
-        })
-        .collect()
 }
 
 const DONE: [&str; 7] = [

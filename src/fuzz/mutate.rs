@@ -171,128 +171,241 @@ fn structured(target: Target, seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
     }
 }
 
-/// A path into a value tree.
+/// A step of a path into a value tree.
 enum Step {
     Index(usize),
     Key(String),
 }
 
-fn json_path(v: &serde_json::Value, rng: &mut ChaCha8Rng) -> Vec<Step> {
+/// A parsed document the structured mutations walk: a JSON or a TOML value. The walk and
+/// the mutations are written once over this; each format says how its nodes look.
+trait Tree: Clone + Sized {
+    /// Chance of stopping at each level of a random path.
+    const STOP: f64;
+    /// Most array levels one nesting mutation wraps a node in.
+    const NEST: usize;
+    /// The node's elements when it is an array.
+    fn items(&self) -> Option<&Vec<Self>>;
+    /// The node's elements when it is an array, to change.
+    fn items_mut(&mut self) -> Option<&mut Vec<Self>>;
+    /// The node's entries when it is a table/object, in order.
+    fn entries(&self) -> Option<Vec<(&String, &Self)>>;
+    /// The entry `key` of a table/object.
+    fn entry_mut(&mut self, key: &str) -> Option<&mut Self>;
+    /// Remove the entry `key` (tables/objects only).
+    fn remove_key(&mut self, key: &str);
+    /// Insert `value` at `key` (tables/objects only).
+    fn insert_key(&mut self, key: &str, value: Self);
+    /// A random value, often one that is out of range somewhere.
+    fn random(rng: &mut ChaCha8Rng) -> Self;
+    /// Scale a number by a factor that breaks it (other nodes stay).
+    fn scale(&mut self, rng: &mut ChaCha8Rng);
+    /// Wrap the node in a one-element array.
+    fn nest(&mut self);
+}
+
+impl Tree for serde_json::Value {
+    const STOP: f64 = 0.25;
+    const NEST: usize = 200;
+    fn items(&self) -> Option<&Vec<Self>> {
+        self.as_array()
+    }
+    fn items_mut(&mut self) -> Option<&mut Vec<Self>> {
+        self.as_array_mut()
+    }
+    fn entries(&self) -> Option<Vec<(&String, &Self)>> {
+        self.as_object().map(|o| o.iter().collect())
+    }
+    fn entry_mut(&mut self, key: &str) -> Option<&mut Self> {
+        self.as_object_mut()?.get_mut(key)
+    }
+    fn remove_key(&mut self, key: &str) {
+        if let Some(o) = self.as_object_mut() {
+            o.remove(key);
+        }
+    }
+    fn insert_key(&mut self, key: &str, value: Self) {
+        if let Some(o) = self.as_object_mut() {
+            o.insert(key.into(), value);
+        }
+    }
+    fn random(rng: &mut ChaCha8Rng) -> Self {
+        use serde_json::{Value, json};
+        match rng.random_range(0..9) {
+            0 | 1 => json!(FLOATS[rng.random_range(0..FLOATS.len())]),
+            2 => json!(INTEGERS[rng.random_range(0..INTEGERS.len())]),
+            3 => json!(STRINGS[rng.random_range(0..STRINGS.len())]),
+            4 => Value::Null,
+            5 => json!(rng.random_bool(0.5)),
+            6 => json!([]),
+            7 => json!({}),
+            _ => {
+                let n = rng.random_range(0..5);
+                Value::Array((0..n).map(|_| json!(rng.random_range(-3.0..3.0))).collect())
+            }
+        }
+    }
+    fn scale(&mut self, rng: &mut ChaCha8Rng) {
+        if let Some(x) = self.as_f64() {
+            let f = [-1.0, 1e6, 1e-6, 1.0 + 1e-7, 0.0, 2.0][rng.random_range(0..6)];
+            if let Some(n) = serde_json::Number::from_f64(x * f) {
+                *self = serde_json::Value::Number(n);
+            }
+        }
+    }
+    fn nest(&mut self) {
+        *self = serde_json::Value::Array(vec![self.take()]);
+    }
+}
+
+impl Tree for toml::Value {
+    const STOP: f64 = 0.2;
+    const NEST: usize = 100;
+    fn items(&self) -> Option<&Vec<Self>> {
+        self.as_array()
+    }
+    fn items_mut(&mut self) -> Option<&mut Vec<Self>> {
+        self.as_array_mut()
+    }
+    fn entries(&self) -> Option<Vec<(&String, &Self)>> {
+        self.as_table().map(|t| t.iter().collect())
+    }
+    fn entry_mut(&mut self, key: &str) -> Option<&mut Self> {
+        self.as_table_mut()?.get_mut(key)
+    }
+    fn remove_key(&mut self, key: &str) {
+        if let Some(t) = self.as_table_mut() {
+            t.remove(key);
+        }
+    }
+    fn insert_key(&mut self, key: &str, value: Self) {
+        if let Some(t) = self.as_table_mut() {
+            t.insert(key.into(), value);
+        }
+    }
+    fn random(rng: &mut ChaCha8Rng) -> Self {
+        use toml::Value;
+        match rng.random_range(0..9) {
+            0 => Value::Float(FLOATS[rng.random_range(0..FLOATS.len())]),
+            1 => Value::Float([f64::NAN, f64::INFINITY, f64::NEG_INFINITY][rng.random_range(0..3)]),
+            2 => Value::Integer(INTEGERS[rng.random_range(0..INTEGERS.len())]),
+            3 => Value::String(STRINGS[rng.random_range(0..STRINGS.len())].into()),
+            4 => Value::Boolean(rng.random_bool(0.5)),
+            5 => Value::Array(Vec::new()),
+            6 => Value::Table(toml::Table::new()),
+            7 => Value::String("x".repeat(rng.random_range(100..20_000))),
+            _ => {
+                let n = rng.random_range(0..5);
+                Value::Array(
+                    (0..n)
+                        .map(|_| Value::Float(rng.random_range(-3.0..3.0)))
+                        .collect(),
+                )
+            }
+        }
+    }
+    fn scale(&mut self, rng: &mut ChaCha8Rng) {
+        match self {
+            toml::Value::Float(x) => {
+                *x *= [-1.0, 1e6, 1e-6, 1.0 + 1e-7, 0.0][rng.random_range(0..5)]
+            }
+            toml::Value::Integer(i) => {
+                *i = i.wrapping_mul([-1, 1000, 0, 2, 1 << 20][rng.random_range(0..5)])
+            }
+            _ => {}
+        }
+    }
+    fn nest(&mut self) {
+        let inner = std::mem::replace(self, toml::Value::Boolean(false));
+        *self = toml::Value::Array(vec![inner]);
+    }
+}
+
+/// A random path from `v` down its arrays and tables.
+fn random_path<T: Tree>(mut v: &T, rng: &mut ChaCha8Rng) -> Vec<Step> {
     let mut path = Vec::new();
-    let mut v = v;
     loop {
-        if rng.random_bool(0.25) {
+        if rng.random_bool(T::STOP) {
             return path;
         }
-        match v {
-            serde_json::Value::Array(a) if !a.is_empty() => {
-                let i = rng.random_range(0..a.len());
-                path.push(Step::Index(i));
-                v = &a[i];
-            }
-            serde_json::Value::Object(o) if !o.is_empty() => {
-                let i = rng.random_range(0..o.len());
-                let Some((k, next)) = o.iter().nth(i) else {
-                    return path;
-                };
-                path.push(Step::Key(k.clone()));
-                v = next;
-            }
-            _ => return path,
+        if let Some(a) = v.items().filter(|a| !a.is_empty()) {
+            let i = rng.random_range(0..a.len());
+            path.push(Step::Index(i));
+            v = &a[i];
+        } else if let Some(e) = v.entries().filter(|e| !e.is_empty()) {
+            let (k, next) = e[rng.random_range(0..e.len())];
+            path.push(Step::Key(k.clone()));
+            v = next;
+        } else {
+            return path;
         }
     }
 }
 
-fn json_at<'a>(
-    mut v: &'a mut serde_json::Value,
-    path: &[Step],
-) -> Option<&'a mut serde_json::Value> {
+/// The node at `path`, if the tree still has it.
+fn node_at<'a, T: Tree>(mut v: &'a mut T, path: &[Step]) -> Option<&'a mut T> {
     for s in path {
-        v = match (v, s) {
-            (serde_json::Value::Array(a), Step::Index(i)) => a.get_mut(*i)?,
-            (serde_json::Value::Object(o), Step::Key(k)) => o.get_mut(k)?,
-            _ => return None,
+        v = match s {
+            Step::Index(i) => v.items_mut()?.get_mut(*i)?,
+            Step::Key(k) => v.entry_mut(k)?,
         };
     }
     Some(v)
 }
 
-fn json_value(rng: &mut ChaCha8Rng) -> serde_json::Value {
-    use serde_json::{Value, json};
+/// One mutation of `node`: replaced, an element dropped, duplicated or cut off, an entry
+/// dropped or added, a number broken, or the node nested deep.
+fn mutate_node<T: Tree>(node: &mut T, rng: &mut ChaCha8Rng) {
     match rng.random_range(0..9) {
-        0 | 1 => json!(FLOATS[rng.random_range(0..FLOATS.len())]),
-        2 => json!(INTEGERS[rng.random_range(0..INTEGERS.len())]),
-        3 => json!(STRINGS[rng.random_range(0..STRINGS.len())]),
-        4 => Value::Null,
-        5 => json!(rng.random_bool(0.5)),
-        6 => json!([]),
-        7 => json!({}),
-        _ => {
-            let n = rng.random_range(0..5);
-            Value::Array((0..n).map(|_| json!(rng.random_range(-3.0..3.0))).collect())
-        }
-    }
-}
-
-fn mutate_json(node: &mut serde_json::Value, rng: &mut ChaCha8Rng) {
-    use serde_json::Value;
-    match rng.random_range(0..9) {
-        0 | 1 => *node = json_value(rng),
+        0 | 1 => *node = T::random(rng),
         2 => {
-            if let Value::Array(a) = node
-                && !a.is_empty()
-            {
+            if let Some(a) = node.items_mut().filter(|a| !a.is_empty()) {
                 let i = rng.random_range(0..a.len());
                 a.remove(i);
             }
         }
         3 => {
-            if let Value::Array(a) = node
-                && !a.is_empty()
-                && a.len() < 5000
-            {
+            if let Some(a) = node.items_mut().filter(|a| !a.is_empty() && a.len() < 5000) {
                 let i = rng.random_range(0..a.len());
                 let x = a[i].clone();
                 a.insert(i, x);
             }
         }
         4 => {
-            if let Value::Object(o) = node
-                && !o.is_empty()
-            {
-                let i = rng.random_range(0..o.len());
-                if let Some(k) = o.keys().nth(i).cloned() {
-                    o.remove(&k);
-                }
+            let key = node
+                .entries()
+                .filter(|e| !e.is_empty())
+                .map(|e| e[rng.random_range(0..e.len())].0.clone());
+            if let Some(k) = key {
+                node.remove_key(&k);
             }
         }
         5 => {
-            if let Value::Object(o) = node {
-                o.insert(
-                    KEYS[rng.random_range(0..KEYS.len())].into(),
-                    json_value(rng),
-                );
-            }
+            let key = KEYS[rng.random_range(0..KEYS.len())];
+            let value = T::random(rng);
+            node.insert_key(key, value);
         }
-        6 => {
-            if let Some(x) = node.as_f64() {
-                let f = [-1.0, 1e6, 1e-6, 1.0 + 1e-7, 0.0, 2.0][rng.random_range(0..6)];
-                if let Some(n) = serde_json::Number::from_f64(x * f) {
-                    *node = Value::Number(n);
-                }
-            }
-        }
+        6 => node.scale(rng),
         7 => {
-            if let Value::Array(a) = node {
+            if let Some(a) = node.items_mut() {
                 let n = rng.random_range(0..=a.len());
                 a.truncate(n);
             }
         }
         _ => {
-            // Nest the node deep.
-            for _ in 0..rng.random_range(1..200) {
-                *node = Value::Array(vec![node.take()]);
+            for _ in 0..rng.random_range(1..T::NEST) {
+                node.nest();
             }
+        }
+    }
+}
+
+/// A few mutations of `tree` at random places.
+fn mutate_tree<T: Tree>(tree: &mut T, rng: &mut ChaCha8Rng) {
+    for _ in 0..rng.random_range(1..5) {
+        let path = random_path(tree, rng);
+        if let Some(node) = node_at(tree, &path) {
+            mutate_node(node, rng);
         }
     }
 }
@@ -301,134 +414,8 @@ fn json_tree(seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
     let Ok(mut v) = serde_json::from_slice::<serde_json::Value>(seed) else {
         return seed.to_vec();
     };
-    for _ in 0..rng.random_range(1..5) {
-        let path = json_path(&v, rng);
-        if let Some(node) = json_at(&mut v, &path) {
-            mutate_json(node, rng);
-        }
-    }
+    mutate_tree(&mut v, rng);
     serde_json::to_vec(&v).unwrap_or_else(|_| seed.to_vec())
-}
-
-fn toml_path(v: &toml::Value, rng: &mut ChaCha8Rng) -> Vec<Step> {
-    let mut path = Vec::new();
-    let mut v = v;
-    loop {
-        if rng.random_bool(0.2) {
-            return path;
-        }
-        match v {
-            toml::Value::Array(a) if !a.is_empty() => {
-                let i = rng.random_range(0..a.len());
-                path.push(Step::Index(i));
-                v = &a[i];
-            }
-            toml::Value::Table(t) if !t.is_empty() => {
-                let i = rng.random_range(0..t.len());
-                let Some((k, next)) = t.iter().nth(i) else {
-                    return path;
-                };
-                path.push(Step::Key(k.clone()));
-                v = next;
-            }
-            _ => return path,
-        }
-    }
-}
-
-fn toml_at<'a>(mut v: &'a mut toml::Value, path: &[Step]) -> Option<&'a mut toml::Value> {
-    for s in path {
-        v = match (v, s) {
-            (toml::Value::Array(a), Step::Index(i)) => a.get_mut(*i)?,
-            (toml::Value::Table(t), Step::Key(k)) => t.get_mut(k)?,
-            _ => return None,
-        };
-    }
-    Some(v)
-}
-
-fn toml_value(rng: &mut ChaCha8Rng) -> toml::Value {
-    use toml::Value;
-    match rng.random_range(0..9) {
-        0 => Value::Float(FLOATS[rng.random_range(0..FLOATS.len())]),
-        1 => Value::Float([f64::NAN, f64::INFINITY, f64::NEG_INFINITY][rng.random_range(0..3)]),
-        2 => Value::Integer(INTEGERS[rng.random_range(0..INTEGERS.len())]),
-        3 => Value::String(STRINGS[rng.random_range(0..STRINGS.len())].into()),
-        4 => Value::Boolean(rng.random_bool(0.5)),
-        5 => Value::Array(Vec::new()),
-        6 => Value::Table(toml::Table::new()),
-        7 => Value::String("x".repeat(rng.random_range(100..20_000))),
-        _ => {
-            let n = rng.random_range(0..5);
-            Value::Array(
-                (0..n)
-                    .map(|_| Value::Float(rng.random_range(-3.0..3.0)))
-                    .collect(),
-            )
-        }
-    }
-}
-
-fn mutate_toml(node: &mut toml::Value, rng: &mut ChaCha8Rng) {
-    use toml::Value;
-    match rng.random_range(0..9) {
-        0 | 1 => *node = toml_value(rng),
-        2 => {
-            if let Value::Array(a) = node
-                && !a.is_empty()
-            {
-                let i = rng.random_range(0..a.len());
-                a.remove(i);
-            }
-        }
-        3 => {
-            if let Value::Array(a) = node
-                && !a.is_empty()
-                && a.len() < 5000
-            {
-                let i = rng.random_range(0..a.len());
-                let x = a[i].clone();
-                a.insert(i, x);
-            }
-        }
-        4 => {
-            if let Value::Table(t) = node
-                && !t.is_empty()
-            {
-                let i = rng.random_range(0..t.len());
-                if let Some(k) = t.keys().nth(i).cloned() {
-                    t.remove(&k);
-                }
-            }
-        }
-        5 => {
-            if let Value::Table(t) = node {
-                t.insert(
-                    KEYS[rng.random_range(0..KEYS.len())].into(),
-                    toml_value(rng),
-                );
-            }
-        }
-        6 => match node {
-            Value::Float(x) => *x *= [-1.0, 1e6, 1e-6, 1.0 + 1e-7, 0.0][rng.random_range(0..5)],
-            Value::Integer(i) => {
-                *i = i.wrapping_mul([-1, 1000, 0, 2, 1 << 20][rng.random_range(0..5)])
-            }
-            _ => {}
-        },
-        7 => {
-            if let Value::Array(a) = node {
-                let n = rng.random_range(0..=a.len());
-                a.truncate(n);
-            }
-        }
-        _ => {
-            for _ in 0..rng.random_range(1..100) {
-                let inner = std::mem::replace(node, Value::Boolean(false));
-                *node = Value::Array(vec![inner]);
-            }
-        }
-    }
 }
 
 fn toml_tree(seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
@@ -439,12 +426,7 @@ fn toml_tree(seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
     else {
         return seed.to_vec();
     };
-    for _ in 0..rng.random_range(1..5) {
-        let path = toml_path(&v, rng);
-        if let Some(node) = toml_at(&mut v, &path) {
-            mutate_toml(node, rng);
-        }
-    }
+    mutate_tree(&mut v, rng);
     match v {
         toml::Value::Table(t) => toml::to_string(&t)
             .map(String::into_bytes)

@@ -535,26 +535,39 @@ impl CreaseGraph {
 
     /// The r2 matches in increasing order of their sorted name pairs, with their notation.
     pub fn r2_matches(&self) -> Vec<(Step, R2Match)> {
+        self.pair_matches(
+            |v| v.ty == VertexType::Extendable,
+            |a, b| self.r2_reason(a, b).is_ok(),
+            Step::Combine,
+        )
+    }
+
+    /// The matches of a combining rule (r2 or r2′) over the vertices `eligible` admits,
+    /// in increasing order of their sorted name pairs; `ok(c1, c2)` says whether the rule
+    /// applies with those roles, `step` writes its notation. Both roles of one pair may
+    /// match: the second is written with the names swapped.
+    pub(super) fn pair_matches(
+        &self,
+        eligible: impl Fn(&super::Vertex) -> bool,
+        ok: impl Fn(Vid, Vid) -> bool,
+        step: fn(usize, usize) -> Step,
+    ) -> Vec<(Step, R2Match)> {
         let chi: Vec<(usize, Vid)> = self
             .vertices()
             .enumerate()
-            .filter(|(_, v)| v.ty == VertexType::Extendable)
+            .filter(|(_, v)| eligible(v))
             .map(|(i, v)| (i + 1, v.vid))
             .collect();
         let mut out = Vec::new();
         for (x, &(ni, vi)) in chi.iter().enumerate() {
             for &(nj, vj) in &chi[x + 1..] {
-                let first = self.r2_reason(vi, vj).is_ok();
+                let first = ok(vi, vj);
                 if first {
-                    out.push((Step::Combine(ni, nj), R2Match { c1: vi, c2: vj }));
+                    out.push((step(ni, nj), R2Match { c1: vi, c2: vj }));
                 }
-                if self.r2_reason(vj, vi).is_ok() {
-                    let step = if first {
-                        Step::Combine(nj, ni)
-                    } else {
-                        Step::Combine(ni, nj)
-                    };
-                    out.push((step, R2Match { c1: vj, c2: vi }));
+                if ok(vj, vi) {
+                    let s = if first { step(nj, ni) } else { step(ni, nj) };
+                    out.push((s, R2Match { c1: vj, c2: vi }));
                 }
             }
         }

@@ -255,30 +255,11 @@ impl CreaseGraph {
     /// The r2′ matches in increasing order of their sorted name pairs, with their notation
     /// (r2′ off: the enumeration does not ask).
     pub fn r2p_matches(&self) -> Vec<(Step, StraightSink)> {
-        let chi: Vec<(usize, Vid)> = self
-            .vertices()
-            .enumerate()
-            .filter(|(_, v)| v.ty == VertexType::Extendable && v.preds.len() == 1 && !v.in_g0())
-            .map(|(i, v)| (i + 1, v.vid))
-            .collect();
-        let mut out = Vec::new();
-        for (x, &(ni, vi)) in chi.iter().enumerate() {
-            for &(nj, vj) in &chi[x + 1..] {
-                let first = self.r2p_reason(vi, vj).is_ok();
-                if first {
-                    out.push((Step::Straight(ni, nj), R2Match { c1: vi, c2: vj }));
-                }
-                if self.r2p_reason(vj, vi).is_ok() {
-                    let step = if first {
-                        Step::Straight(nj, ni)
-                    } else {
-                        Step::Straight(ni, nj)
-                    };
-                    out.push((step, R2Match { c1: vj, c2: vi }));
-                }
-            }
-        }
-        out
+        self.pair_matches(
+            |v| v.ty == VertexType::Extendable && v.preds.len() == 1 && !v.in_g0(),
+            |a, b| self.r2p_reason(a, b).is_ok(),
+            Step::Straight,
+        )
     }
 
     /// Apply `(x, y)'` with the names as they are now.
