@@ -300,7 +300,7 @@ impl Model {
         p.internal
             .iter()
             .copied()
-            .filter(|&v| p.vertices[v].rays.len() % 2 == 0)
+            .filter(|&v| p.vertices[v].rays.len().is_multiple_of(2))
             .collect()
     }
 
@@ -318,7 +318,7 @@ impl Model {
                 .iter()
                 .enumerate()
                 .fold(S::from_f64(0.0), |acc, (k, a)| {
-                    if k % 2 == 0 {
+                    if k.is_multiple_of(2) {
                         acc + a.clone()
                     } else {
                         acc - a.clone()
