@@ -288,7 +288,7 @@ fn scenarios() -> Vec<Scenario> {
         // r1,2: s3 exists, F_L(a,s3) = F_L(p1,a).
         Scenario {
             number: 2,
-            extra: v("v3", 1.0, 1.0, "terminal") + &c("v2", "v3", "f1", "f3"),
+            extra: [v("v3", 1.0, 1.0, "terminal"), c("v2", "v3", "f1", "f3")].concat(),
             new: vec![(1, "f4", "f2"), (2, "f3", "f4")],
             placed: vec![(1, 1, 1.0, 1), (2, 1, 1.0, 2)],
             remainder: (2, 3),
@@ -296,7 +296,7 @@ fn scenarios() -> Vec<Scenario> {
         // r1,3: s1 exists, F_R(a,s1) = F_R(pm,a); s2 is placed from s1.
         Scenario {
             number: 3,
-            extra: v("v3", 1.0, -1.0, "terminal") + &c("v2", "v3", "f3", "f2"),
+            extra: [v("v3", 1.0, -1.0, "terminal"), c("v2", "v3", "f3", "f2")].concat(),
             new: vec![(2, "f4", "f3"), (3, "f1", "f4")],
             placed: vec![(2, 3, 1.0, 1), (3, 1, -1.0, 1)],
             remainder: (2, 3),
@@ -304,10 +304,13 @@ fn scenarios() -> Vec<Scenario> {
         // r1,4: s2 and s3 exist; the remainder lies between s1 and s2.
         Scenario {
             number: 4,
-            extra: v("v3", 2.0, 0.0, "terminal")
-                + &v("v4", 1.0, 1.0, "terminal")
-                + &c("v2", "v3", "f3", "f4")
-                + &c("v2", "v4", "f1", "f3"),
+            extra: [
+                v("v3", 2.0, 0.0, "terminal"),
+                v("v4", 1.0, 1.0, "terminal"),
+                c("v2", "v3", "f3", "f4"),
+                c("v2", "v4", "f1", "f3"),
+            ]
+            .concat(),
             new: vec![(1, "f4", "f2")],
             placed: vec![(1, 1, 1.0, 1)],
             remainder: (1, 2),
@@ -315,10 +318,13 @@ fn scenarios() -> Vec<Scenario> {
         // r1,5: s1 and s3 exist.
         Scenario {
             number: 5,
-            extra: v("v3", 1.0, -1.0, "terminal")
-                + &v("v4", 1.0, 1.0, "terminal")
-                + &c("v2", "v3", "f3", "f2")
-                + &c("v2", "v4", "f1", "f4"),
+            extra: [
+                v("v3", 1.0, -1.0, "terminal"),
+                v("v4", 1.0, 1.0, "terminal"),
+                c("v2", "v3", "f3", "f2"),
+                c("v2", "v4", "f1", "f4"),
+            ]
+            .concat(),
             new: vec![(2, "f4", "f3")],
             placed: vec![(2, 3, 1.0, 1)],
             remainder: (2, 3),
@@ -326,10 +332,13 @@ fn scenarios() -> Vec<Scenario> {
         // r1,6: s1 and s2 exist.
         Scenario {
             number: 6,
-            extra: v("v3", 1.0, -1.0, "terminal")
-                + &v("v4", 2.0, 0.0, "terminal")
-                + &c("v2", "v3", "f3", "f2")
-                + &c("v2", "v4", "f4", "f3"),
+            extra: [
+                v("v3", 1.0, -1.0, "terminal"),
+                v("v4", 2.0, 0.0, "terminal"),
+                c("v2", "v3", "f3", "f2"),
+                c("v2", "v4", "f4", "f3"),
+            ]
+            .concat(),
             new: vec![(3, "f1", "f4")],
             placed: vec![(3, 1, -1.0, 1)],
             remainder: (2, 3),
@@ -616,12 +625,15 @@ fn r2_match_conditions_are_enforced() {
 /// G0 with two χ vertices on one facet: v1 → v2 and v3 → v4, joined by v1 → v3.
 fn two_chi() -> Task {
     task_with(
-        &(vertex("v3", 0.0, 2.0, "terminal")
-            + &vertex("v4", 1.0, 1.0, "extendable")
-            + &crease("v1", "v3", "f4", "f1")
-            + "drive = \"t\"\n"
-            + &crease("v3", "v4", "f3", "f1")
-            + "drive = \"t\"\n"),
+        &[
+            vertex("v3", 0.0, 2.0, "terminal"),
+            vertex("v4", 1.0, 1.0, "extendable"),
+            crease("v1", "v3", "f4", "f1"),
+            "drive = \"t\"\n".to_string(),
+            crease("v3", "v4", "f3", "f1"),
+            "drive = \"t\"\n".to_string(),
+        ]
+        .concat(),
     )
 }
 

@@ -121,3 +121,117 @@ fn block_values_and_gradients_match_f64_kinematics_and_central_differences() {
         assert!(checked.contains(&g), "no plane of {g:?} was checked");
     }
 }
+
+/// The flat layout's feature constraints (issue 20): the compiled layout equals the f64
+/// geometry, the constraints' least distance equals the independent measurement of
+/// `check::features` on the exported pattern, their augmented-Lagrangian term's gradient
+/// agrees with central differences, and `accept` refuses a layout below the setting.
+#[test]
+fn feature_constraints_match_the_independent_measurement_and_central_differences() {
+    use foldsynth::check::features::pattern_min_feature;
+    use foldsynth::model::geometry;
+    use foldsynth::model::numeric::Evaluated;
+    use foldsynth::model::robust::Level;
+    use foldsynth::optimize::Acceptance;
+
+    let task = Task::load(GRIPPER).unwrap();
+    let enumeration = Enumeration::run(&task, 2, Filters::all());
+    let mut spec = RobustSpec::from_task(&task, 181);
+    // Far above the default, so that many pairs are violated or near their bound and the
+    // merit's penalty and multiplier branches are both exercised.
+    const REQ: f64 = 0.6;
+    spec.settings.min_feature = REQ;
+    let mut models = 0;
+    for node in enumeration.meaningful() {
+        let n = node.graph.internal_count();
+        for candidate in 0..3 {
+            let Ok(model) = Model::new(&node.graph, &task, candidate) else {
+                continue;
+            };
+            let block = RobustModel::new(&model, spec.clone()).unwrap();
+            let modes = vec![1.0; n];
+            // A point inside the bounds, different for every variable.
+            let x: Vec<f64> = (0..model.free.len())
+                .map(|i| {
+                    let (lo, hi) = model.var_bounds(model.free[i]);
+                    let u = (0.618_034 * (i + 1) as f64).fract();
+                    lo + (hi - lo) * (0.2 + 0.6 * u)
+                })
+                .collect();
+            let mut work = block.work();
+            block.eval_flat(&x, &mut work);
+            let full = model.full_vars(&x);
+            let plain = geometry::flat(&model.plan, &full);
+            for (a, b) in work.flat.iter().zip(&plain.pos) {
+                assert!((a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12);
+            }
+            // The least distance the constraints see = check::features on the pattern.
+            let mut least = f64::INFINITY;
+            block.visit_features(&work.flat, Level::Setting, |_, h, _| {
+                least = least.min(h + REQ);
+            });
+            let pattern = Evaluated::new(&model.plan, full, modes.clone()).pattern(&[0.0]);
+            let measured = pattern_min_feature(&pattern).unwrap();
+            assert!(
+                (least - measured.value).abs() < 1e-12,
+                "{least} vs {measured:?}"
+            );
+            assert!(
+                measured.value < REQ,
+                "no pair below the bound: {measured:?}"
+            );
+            // Gradient of the merit term against central differences.
+            let lambda: Vec<f64> = (0..block.feature_slots())
+                .map(|k| {
+                    if k % 3 == 0 {
+                        0.0
+                    } else {
+                        0.5 + 0.4 * (k as f64).sin()
+                    }
+                })
+                .collect();
+            let mu = 10.0;
+            let mut g = vec![0.0; x.len()];
+            block.feature_merit(&x, &lambda, mu, &mut work, &mut g);
+            let mut scratch = vec![0.0; x.len()];
+            let mut merit =
+                |x: &[f64]| block.feature_merit(x, &lambda, mu, &mut work, &mut scratch);
+            for i in 0..x.len() {
+                let (mut xp, mut xm) = (x.clone(), x.clone());
+                xp[i] += 1e-6;
+                xm[i] -= 1e-6;
+                let fd = (merit(&xp) - merit(&xm)) / 2e-6;
+                assert!(
+                    (fd - g[i]).abs() <= 1e-5 * (1.0 + g[i].abs()),
+                    "feature merit, x{i}: {} vs central differences {fd}",
+                    g[i]
+                );
+            }
+            assert!(g.iter().any(|d| d.abs() > 1e-3), "no gradient: {g:?}");
+            // The block refuses the layout, and reports the violation from update.
+            let rp = RobustProblem::new(&model, &block, &modes);
+            assert!(!rp.features_hold(&x, Level::Accept));
+            assert_eq!(rp.accept(&x), Acceptance::Rejected);
+            let v = rp.update(&x, None);
+            assert!(v >= REQ * 1.01 - measured.value - 1e-12, "{v}");
+            // At a setting below the layout's smallest feature it holds; 0 turns it off.
+            for s in [0.5 * measured.value, 0.0] {
+                let mut off = spec.clone();
+                off.settings.min_feature = s;
+                let block = RobustModel::new(&model, off).unwrap();
+                let rp = RobustProblem::new(&model, &block, &modes);
+                assert!(rp.features_hold(&x, Level::Imposed));
+                let mut g = vec![0.0; x.len()];
+                let lambda = vec![0.0; block.feature_slots()];
+                let mut work = block.work();
+                assert_eq!(block.feature_merit(&x, &lambda, mu, &mut work, &mut g), 0.0);
+                assert!(g.iter().all(|d| *d == 0.0));
+            }
+            models += 1;
+            if models == 4 {
+                return;
+            }
+        }
+    }
+    panic!("only {models} models were checked");
+}

@@ -4,9 +4,10 @@
 //!   clearance constraints (`--post-check-only`) becomes feasible with them, and the
 //!   independent post-checks (Möller, cylinder, rigidity, `verify`, on the dense sweep)
 //!   agree;
-//! - every design the constrained optimizer accepts keeps its margins (rigid margin, self, arm and
-//!   obstacle clearance) at least at the task's settings on a 721-state sweep, measured by
-//!   `check::robustness` (exact distances, no code shared with the constraints);
+//! - every design the constrained optimizer accepts keeps its margins (rigid margin, self, arm
+//!   and obstacle clearance, the flat layout's smallest feature) at least at the task's
+//!   settings on a 721-state sweep, measured by `check::robustness` (exact distances, no
+//!   code shared with the constraints);
 //! - designs are ranked most robust first in `summary.json` and `designs/<id>.json`.
 
 use foldsynth::grammar::{Enumeration, Filters};
@@ -118,6 +119,10 @@ fn constraints_make_self_intersecting_optima_feasible_and_margins_hold_on_a_dens
         assert!(arm.value >= s.clearance, "{}: {:?}", r.key, arm);
         let obs = m.obstacle_clearance.as_ref().expect("the cylinder");
         assert!(obs.value >= s.obstacle_clearance, "{}: {:?}", r.key, obs);
+        // The flat layout's smallest feature (issue 20), measured by check::features.
+        let mf = m.min_feature.as_ref().expect("min feature measured");
+        assert!(s.min_feature > 0.0 && mf.setting == s.min_feature);
+        assert!(mf.value >= s.min_feature, "{}: {:?}", r.key, mf);
         assert!(m.meets_settings() && m.score >= 1.0, "{}: {:?}", r.key, m);
     }
 
@@ -142,6 +147,7 @@ fn constraints_make_self_intersecting_optima_feasible_and_margins_hold_on_a_dens
             "self_clearance",
             "arm_clearance",
             "obstacle_clearance",
+            "min_feature",
         ] {
             let m = &d["robustness"][k];
             assert!(m["value"].is_f64() && m["setting"].is_f64() && m["where"].is_string());

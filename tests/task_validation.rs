@@ -501,13 +501,15 @@ fn a_task_name_is_a_safe_directory_name() {
 
 #[test]
 fn robustness_defaults_and_settings() {
-    use foldsynth::task::{DEFAULT_CLEARANCE, DEFAULT_RIGID_MARGIN};
+    use foldsynth::task::{DEFAULT_CLEARANCE, DEFAULT_MIN_FEATURE, DEFAULT_RIGID_MARGIN};
     // Absent: 1° and 1% of G0's crease.
     let t = Task::from_toml_str(BASE, "ok.toml").unwrap();
     assert_eq!(t.robustness.rigid_margin, PI / 180.0);
     assert_eq!(t.robustness.rigid_margin, DEFAULT_RIGID_MARGIN);
     assert_eq!(t.robustness.clearance, DEFAULT_CLEARANCE);
     assert_eq!(t.robustness.obstacle_clearance, 0.01);
+    assert_eq!(t.robustness.min_feature, DEFAULT_MIN_FEATURE);
+    assert_eq!(DEFAULT_MIN_FEATURE, 0.015);
     // Given (expressions allowed), the others keep their defaults; zeros are allowed.
     let t = Task::from_toml_str(
         &(BASE.to_owned() + "[robustness]\nrigid_margin = \"pi/90\"\nclearance = 0\n"),
@@ -517,6 +519,18 @@ fn robustness_defaults_and_settings() {
     assert_eq!(t.robustness.rigid_margin, PI / 90.0);
     assert_eq!(t.robustness.clearance, 0.0);
     assert_eq!(t.robustness.obstacle_clearance, DEFAULT_CLEARANCE);
+    let t = Task::from_toml_str(
+        &(BASE.to_owned() + "[robustness]\nmin_feature = \"3/200\"\n"),
+        "ok.toml",
+    )
+    .unwrap();
+    assert_eq!(t.robustness.min_feature, 0.015);
+    let t = Task::from_toml_str(
+        &(BASE.to_owned() + "[robustness]\nmin_feature = 0\n"),
+        "ok.toml",
+    )
+    .unwrap();
+    assert_eq!(t.robustness.min_feature, 0.0);
     // The optimizer's states default to 9.
     let t = Task::from_toml_str(&(BASE.to_owned() + "[check]\nstates = 16\n"), "ok.toml").unwrap();
     assert_eq!(t.check.unwrap().optimize_states, 9);
@@ -551,6 +565,17 @@ fn bad_robustness_values_are_refused_with_file_and_field() {
     assert_err(&e, "robustness.rigid_margin", &["2π/3"]);
     let e = err(&with("[robustness]\nrigid_margin = \"pi/\"\n"));
     assert_eq!(e.field, "robustness.rigid_margin");
+    // The flat layout's smallest feature (issue 20): paper units, below G0's crease.
+    let e = err(&with("[robustness]\nmin_feature = -0.01\n"));
+    assert_err(&e, "robustness.min_feature", &["-0.01", "≥ 0"]);
+    let e = err(&with("[robustness]\nmin_feature = nan\n"));
+    assert_err(&e, "robustness.min_feature", &["not a finite number"]);
+    let e = err(&with("[robustness]\nmin_feature = 1\n"));
+    assert_err(
+        &e,
+        "robustness.min_feature",
+        &["larger than the pattern", "[0, 1)"],
+    );
     let e = err(&with("[robustness]\nmargin = 1\n"));
     assert!(e.message.contains("unknown field"), "{e}");
     let e = err(&with("[check]\nstates = 16\noptimize_states = 1\n"));

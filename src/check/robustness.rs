@@ -20,16 +20,19 @@
 //!   (clearance from the capsule around the axis, which contains the flat-capped cylinder);
 //! - rigid margins: `U_j + U_k − U_i` from the angles between the three creases that bound
 //!   the units of each internal vertex in the folded 3D state (not the PTU's formulas),
-//!   divided by `(t/t_max)²` (the flat state is degenerate; see `task::Robustness`).
+//!   divided by `(t/t_max)²` (the flat state is degenerate; see `task::Robustness`);
+//! - the smallest feature of the arm's flat layout (`check::features`: vertex pairs, vertex
+//!   to edge, edge lengths), reported at t = 0.
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::cylinder::Cylinder;
+use super::features::{self, FeatureKind};
 use super::self_intersection::{CheckError, Checker};
 use super::tri_tri::{Tri, triangles_intersect};
 use crate::pattern::Pattern;
-use crate::task::{DEFAULT_CLEARANCE, DEFAULT_RIGID_MARGIN, Robustness};
+use crate::task::{DEFAULT_CLEARANCE, DEFAULT_MIN_FEATURE, DEFAULT_RIGID_MARGIN, Robustness};
 
 type V = Vector3<f64>;
 
@@ -62,7 +65,8 @@ pub struct RobustnessReport {
     pub arm_clearance: Option<MarginReport>,
     /// Smallest clearance between a facet and an obstacle.
     pub obstacle_clearance: Option<MarginReport>,
-    /// Smallest feature (issue 20; not measured yet).
+    /// Smallest feature of the flat layout (issue 20; paper units, at t = 0): the least
+    /// vertex–vertex or vertex–edge distance or edge length. Absent with a single vertex.
     pub min_feature: Option<MarginReport>,
 }
 
@@ -117,6 +121,8 @@ pub struct RobustnessInput<'a> {
     pub t_max: f64,
     /// The settings margins are held to.
     pub settings: Robustness,
+    /// The arm alone: its flat layout's features are measured.
+    pub arm: &'a Pattern,
 }
 
 /// How two faces relate.
@@ -333,14 +339,32 @@ pub fn measure(input: &RobustnessInput<'_>) -> Result<RobustnessReport, CheckErr
         self_clearance: own.report(s.clearance),
         arm_clearance: arm.report(s.clearance),
         obstacle_clearance: obstacle.report(s.obstacle_clearance),
-        min_feature: None,
+        min_feature: features::pattern_min_feature(input.arm).map(|f| MarginReport {
+            value: f.value,
+            setting: s.min_feature,
+            t: Some(0.0),
+            location: feature_location(&f.kind, vname),
+        }),
     };
     report.score = score(&report);
     Ok(report)
 }
 
+/// Where a feature is, with the vertices' names: `"v3 ↔ v7"`, `"edge v2–v5"`,
+/// `"v4 ↔ edge v1–v2"`.
+fn feature_location(kind: &FeatureKind, name: impl Fn(usize) -> String) -> String {
+    match *kind {
+        FeatureKind::Vertices { a, b } => format!("{} ↔ {}", name(a), name(b)),
+        FeatureKind::Edge { a, b } => format!("edge {}–{}", name(a), name(b)),
+        FeatureKind::VertexEdge { v, a, b } => {
+            format!("{} ↔ edge {}–{}", name(v), name(a), name(b))
+        }
+    }
+}
+
 /// The smallest margin over its setting (settings of 0 skipped); with every setting 0, over
-/// the defaults (1°, 1% of G0's crease) so designs still rank by how close they come.
+/// the defaults (1°, 1% of G0's crease, 0.015 for the feature size) so designs still rank
+/// by how close they come.
 pub fn score(r: &RobustnessReport) -> f64 {
     let ratio = |m: &MarginReport, default: f64| {
         if m.setting > 0.0 {
@@ -357,6 +381,7 @@ pub fn score(r: &RobustnessReport) -> f64 {
                 .iter()
                 .map(|m| ratio(m, DEFAULT_CLEARANCE)),
         )
+        .chain(r.min_feature.iter().map(|m| ratio(m, DEFAULT_MIN_FEATURE)))
         .filter(|(v, _)| v.is_finite())
         .collect();
     let set: Vec<f64> = all.iter().filter(|(_, s)| *s).map(|(v, _)| *v).collect();

@@ -448,6 +448,10 @@ pub fn model_formulas(model: &Model, task: &str, opts: ModelFormulaOptions) -> R
             rep.stop_reason,
             rep.millis
         ),
+        format!(
+            "  then {} zero terms (0*x, x-x) removed beside a term that is NaN wherever they are (x not provably finite)",
+            rep.vanishing_terms
+        ),
         format!("  egg removed: {}", kind_diff(&kb, &ka)),
         format!("  egg added: {}", kind_diff(&ka, &kb)),
         format!(

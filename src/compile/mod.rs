@@ -39,6 +39,7 @@ pub mod jit;
 pub mod simplify;
 #[cfg(feature = "symbolica")]
 pub mod symbolica;
+pub mod vanish;
 pub mod vertex;
 
 pub use codegen::{CompileError, Math, OptLevel};

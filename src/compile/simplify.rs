@@ -26,7 +26,10 @@
 //!   [`ExprGraph::add`] (e-class ranges merge forms that differ by rounding, so they are
 //!   not trusted for that);
 //! - factoring `a·b ± a·c → a·(b ± c)` and `b/a ± c/a → (b ± c)/a` reduce operations and
-//!   change results only by rounding.
+//!   change results only by rounding;
+//! - after the extraction, [`vanish`](super::vanish) removes the zero terms (`0·x`,
+//!   `x - x`) whose `x` is not provably finite but whose NaN a sibling term carries
+//!   anyway: values unchanged, NaN included.
 //!
 //! Rounding differences are amplified where an `acos` argument is within rounding of
 //! ±1 (a vertex at the edge of its rigid range, or flat): there the simplified and the
@@ -242,6 +245,11 @@ impl Analysis<Math> for Facts {
             (None, Math::Mul([a, b])) if egraph.find(*a) == egraph.find(*b) => {
                 Range::square(&ranges[0])
             }
+            // x·sgn x = |x| and x + x·sgn x ≥ 0, as in `ExprGraph`'s analysis.
+            (None, Math::Mul([a, b])) if sgn_of(egraph, *b, *a) => Range::abs(&ranges[0]),
+            (None, Math::Mul([a, b])) if sgn_of(egraph, *a, *b) => Range::abs(&ranges[1]),
+            (None, Math::Add([a, b])) if abs_of(egraph, *b, *a) => Range::plus_abs(&ranges[0]),
+            (None, Math::Add([a, b])) if abs_of(egraph, *a, *b) => Range::plus_abs(&ranges[1]),
             (None, _) => Range::of(&kind, &ranges),
         };
         Data { konst, range }
@@ -278,6 +286,27 @@ impl Analysis<Math> for Facts {
             egraph[id].nodes.retain(|n| n.is_leaf());
         }
     }
+}
+
+/// Whether class `s` holds `sgn(x)`.
+fn sgn_of(eg: &EG, s: Id, x: Id) -> bool {
+    let x = eg.find(x);
+    eg[s]
+        .nodes
+        .iter()
+        .any(|n| matches!(n, Math::Sgn(c) if eg.find(*c) == x))
+}
+
+/// Whether class `m` holds `x · sgn(x)` (either operand order).
+fn abs_of(eg: &EG, m: Id, x: Id) -> bool {
+    let x = eg.find(x);
+    eg[m].nodes.iter().any(|n| match n {
+        Math::Mul([a, b]) => {
+            let (a, b) = (eg.find(*a), eg.find(*b));
+            (a == x && sgn_of(eg, b, x)) || (b == x && sgn_of(eg, a, x))
+        }
+        _ => false,
+    })
 }
 
 fn var(s: &str) -> egg::Var {
@@ -443,6 +472,9 @@ pub struct Report {
     /// (rules that never fired are left out; commutativity is counted like the others).
     /// Applications are unions in the e-graph, not what the extraction kept.
     pub rules_fired: Vec<(String, usize)>,
+    /// Terms removed after the extraction because they vanish wherever the formula has a
+    /// value ([`vanish`](super::vanish): `a + 0·x → a` where `a` carries `x`'s NaN).
+    pub vanishing_terms: usize,
     /// Wall-clock time of the whole call.
     pub millis: f64,
 }
@@ -495,12 +527,14 @@ pub fn simplify(
             graph.extract(outputs)
         }
     };
-    let mut cost_after = dag_cost(&g, &outs);
-    if cost_after > cost_before {
+    if dag_cost(&g, &outs) > cost_before {
         extraction = "input";
         (g, outs) = graph.extract(outputs);
-        cost_after = dag_cost(&g, &outs);
     }
+    // Zero terms egg may not fold (their x is not provably finite) but whose NaN a
+    // sibling carries anyway (see `vanish`); it only removes operations.
+    let (g, outs, vanishing_terms) = super::vanish::fold_vanishing(&g, &outs);
+    let cost_after = dag_cost(&g, &outs);
     let after = g.counts(&outs);
     let mut fired: Vec<(String, usize)> = Vec::new();
     for it in &runner.iterations {
@@ -528,6 +562,7 @@ pub fn simplify(
             .map_or_else(|| "none".to_string(), |r| format!("{r:?}")),
         extraction,
         rules_fired: fired,
+        vanishing_terms,
         millis: t0.elapsed().as_secs_f64() * 1e3,
     };
     (g, outs, report)

@@ -156,6 +156,19 @@ impl ExprGraph {
         }
     }
 
+    /// Whether node `s` is `sgn(x)`.
+    fn is_sgn_of(&self, s: NodeId, x: NodeId) -> bool {
+        matches!(self.nodes[s.index()], Node::Sgn(c) if c == x)
+    }
+
+    /// Whether node `m` is `x · sgn(x)` (either operand order).
+    fn is_abs_of(&self, m: NodeId, x: NodeId) -> bool {
+        match self.nodes[m.index()] {
+            Node::Mul(a, b) => (a == x && self.is_sgn_of(b, x)) || (b == x && self.is_sgn_of(a, x)),
+            _ => false,
+        }
+    }
+
     fn finite(&self, id: NodeId) -> bool {
         self.ranges[id.index()].finite
     }
@@ -383,6 +396,22 @@ impl ExprGraph {
         }
     }
 
+    /// The range of `node` (whose children are in this graph) given ranges of its children
+    /// in operand order: [`Range::of`] plus the relational facts that the interval of each
+    /// operand alone cannot give: `x·x ≥ 0`, `x·sgn x = |x|` and `x + x·sgn x ≥ 0` (max0,
+    /// under the square roots of the PTU).
+    pub fn range_of(&self, node: &Node, args: &[Range]) -> Range {
+        match *node {
+            Node::Select(c, a, _) if c == a => Range::select_positive(&args[0], &args[2]),
+            Node::Mul(a, b) if a == b => Range::square(&args[0]),
+            Node::Mul(a, b) if self.is_sgn_of(b, a) => Range::abs(&args[0]),
+            Node::Mul(a, b) if self.is_sgn_of(a, b) => Range::abs(&args[1]),
+            Node::Add(a, b) if self.is_abs_of(b, a) => Range::plus_abs(&args[0]),
+            Node::Add(a, b) if self.is_abs_of(a, b) => Range::plus_abs(&args[1]),
+            _ => Range::of(node, args),
+        }
+    }
+
     /// The id of a node equal to `node`, if the graph has one (no folding).
     pub fn lookup(&self, node: &Node) -> Option<NodeId> {
         self.index.get(node).copied()
@@ -398,11 +427,7 @@ impl ExprGraph {
             .into_iter()
             .map(|c| self.ranges[c.index()])
             .collect();
-        let range = match node {
-            Node::Select(c, a, _) if c == a => Range::select_positive(&args[0], &args[2]),
-            Node::Mul(a, b) if a == b => Range::square(&args[0]),
-            _ => Range::of(&node, &args),
-        };
+        let range = self.range_of(&node, &args);
         match node {
             Node::Var(i) => self.n_vars = self.n_vars.max(i as usize + 1),
             Node::Param(i) => self.n_params = self.n_params.max(i as usize + 1),
@@ -531,6 +556,46 @@ mod tests {
         let half = g.constant(0.5);
         let d = g.add(Node::Div(x, half));
         assert!(matches!(g.node(d), Node::Mul(..)));
+    }
+
+    #[test]
+    fn max0_under_a_square_root_is_known_finite() {
+        use Node::*;
+        let mut g = ExprGraph::new();
+        let (x, y) = (g.var(0), g.var(1));
+        let s = g.add(Sin(x));
+        let p = g.add(Mul(s, y));
+        // max0(p) as the kinematics writes it: (p + p·sgn p) · 0.5.
+        let sg = g.add(Sgn(p));
+        let abs = g.add(Mul(p, sg));
+        assert!(g.range(abs).finite && g.range(abs).lo == 0.0);
+        let sum = g.add(Add(p, abs));
+        let half = g.constant(0.5);
+        let m = g.add(Mul(sum, half));
+        assert!(g.range(m).finite && g.range(m).lo == 0.0);
+        let r = g.add(Sqrt(m));
+        assert!(g.range(r).finite, "sqrt(max0(·)) is never NaN");
+        let t = g.add(Atan2(r, x));
+        assert!(g.range(t).finite);
+        let zero = g.constant(0.0);
+        assert_eq!(g.const_value(g.clone().add(Mul(zero, t))), Some(0.0));
+        assert_eq!(g.const_value(g.clone().add(Sub(t, t))), Some(0.0));
+        // The graph computes what f64 does, on both sides of zero.
+        for (a, b) in [(0.7f64, 2.0), (0.7, -2.0), (-0.3, 5.0), (0.0, 1.0)] {
+            let pv = a.sin() * b;
+            let want = (pv + pv * crate::kinematics::sgn_f64(pv)) * 0.5;
+            let got = g.eval(&[m], &[a, b], &[])[0];
+            assert!((got - want).abs() <= 1e-15, "{got} {want}");
+        }
+        // The relation needs the same operand: p + p·sgn q may be negative.
+        let q = g.add(Sin(y));
+        let sq = g.add(Sgn(q));
+        let other = g.add(Mul(p, sq));
+        let sum2 = g.add(Add(p, other));
+        let r2 = g.add(Sqrt(sum2));
+        assert!(!g.range(r2).finite);
+        let kept = g.add(Mul(zero, r2));
+        assert!(matches!(g.node(kept), Mul(..)));
     }
 
     #[test]

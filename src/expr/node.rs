@@ -494,6 +494,39 @@ impl Range {
         Range::interval(lo, a.max(b)).with_finite_check(lo, a.max(b))
     }
 
+    /// The range of `x * sgn(x)`: exactly `|x|` for finite `x` (`sgn x` is exactly ±1, or 0
+    /// where `x = 0`), so never negative, unlike a general product of the two ranges.
+    pub fn abs(x: &Range) -> Range {
+        if !x.finite {
+            // inf · 1 = inf and NaN · 0 = NaN: nothing known.
+            return Range::UNKNOWN;
+        }
+        let lo = if x.lo <= 0.0 && x.hi >= 0.0 {
+            0.0
+        } else {
+            x.lo.abs().min(x.hi.abs())
+        };
+        Range {
+            lo,
+            hi: x.mag(),
+            finite: true,
+        }
+    }
+
+    /// The range of `x + x * sgn(x)` (twice `max(0, x)`, how [`Scalar::max0`] writes it):
+    /// `2x` where `x > 0` (exact, but it may overflow), exactly 0 otherwise. This is
+    /// what proves `sqrt(max0(·))` finite, which a range of the sum alone cannot.
+    ///
+    /// [`Scalar::max0`]: crate::kinematics::Scalar::max0
+    pub fn plus_abs(x: &Range) -> Range {
+        if !x.finite {
+            return Range::UNKNOWN;
+        }
+        let lo = 2.0 * x.lo.max(0.0);
+        let hi = 2.0 * x.hi.max(0.0);
+        Range::interval(lo, hi).with_finite_check(lo, hi)
+    }
+
     /// The range of `select(x, x, b)` (`x` where `x > 0`, else `b`): like the hull, but
     /// only the positive part of `x` survives (so `select(x, x, 0) ≥ 0`).
     pub fn select_positive(x: &Range, b: &Range) -> Range {
@@ -543,5 +576,38 @@ mod tests {
         assert!(!d.finite);
         let sq = Range::of(&Node::Sqrt(NodeId(0)), &[sum]);
         assert!(!sq.finite, "sqrt of a possibly negative value may be NaN");
+    }
+
+    #[test]
+    fn abs_and_plus_abs() {
+        let x = Range::interval(-3.0, 2.0);
+        assert_eq!(Range::abs(&x), Range::interval(0.0, 3.0));
+        assert_eq!(
+            Range::abs(&Range::interval(-3.0, -0.5)),
+            Range::interval(0.5, 3.0)
+        );
+        assert_eq!(Range::plus_abs(&x), Range::interval(0.0, 4.0));
+        assert_eq!(
+            Range::plus_abs(&Range::interval(1.0, 2.0)),
+            Range::interval(2.0, 4.0)
+        );
+        assert_eq!(
+            Range::plus_abs(&Range::interval(-2.0, -1.0)),
+            Range::interval(0.0, 0.0)
+        );
+        // Every value of x + x·sgn x at sample points lies in the range.
+        for v in [-3.0, -1e-300, -0.0, 0.0, 1e-300, 1.5, 2.0] {
+            let got = v + v * sgn_f64(v);
+            let r = Range::plus_abs(&x);
+            assert!(got >= r.lo && got <= r.hi, "{v}: {got}");
+            let a = v * sgn_f64(v);
+            assert!((0.0..=3.0).contains(&a), "{v}: {a}");
+        }
+        // 2x may overflow: finite but unbounded x gives nothing, nor does an unknown x.
+        assert!(!Range::plus_abs(&Range::FINITE).finite);
+        assert!(!Range::plus_abs(&Range::interval(0.0, f64::MAX)).finite);
+        assert!(!Range::abs(&Range::UNKNOWN).finite);
+        let a = Range::abs(&Range::FINITE);
+        assert!(a.finite && a.lo == 0.0);
     }
 }

@@ -31,6 +31,22 @@
 //!   sector angles), and its margin — and the effect of a sector error on it — grows as t²
 //!   from there; at t_max the full margin applies, over the motion its t² share.
 //!
+//! ## Feature size of the flat layout (issue 20)
+//!
+//! Independent of t: every two vertices, every vertex and edge (crease or the paper's edge)
+//! it does not end on, are at least `min_feature` apart in the flat layout — so every edge
+//! is at least that long. The in-plane positions are a third compiled function of the
+//! design variables (values and their Jacobian, from the same [`geometry::flat`]); the
+//! distances and their gradients are closed form on top of it. The distance from a vertex
+//! `p` to the segment `a + s(b − a)`, `s ∈ [0, 1]`, is continuously differentiable in all
+//! three points away from 0 (the nearest point is unique, so by Danskin's theorem the
+//! gradient is that of `|p − a − s(b − a)|` at the minimizing `s`, held fixed): one
+//! constraint per vertex–edge pair whose gradient is continuous where the nearest point
+//! passes an end. There it equals that end's vertex-pair constraint, which changes no
+//! feasible set. Every pair is evaluated at every merit evaluation (a few hundred closed-form
+//! distances and one small compiled call: no planes to fit, no state to sample); a pair
+//! adds to the merit and its gradient only while violated or with a multiplier.
+//!
 //! Each requirement is imposed with a 1% safety over its setting (plus a floor that keeps
 //! zero settings strictly clear of contact), so states between the ones sampled keep the
 //! setting; a design is accepted only when a finer sweep (the search's verification
@@ -160,6 +176,10 @@ pub struct Work {
     pub values: StateValues,
     buffers: Buffers,
     weights: Vec<f64>,
+    /// The flat layout of the last [`RobustModel::eval_flat`] (issue 20).
+    pub flat: Vec<[f64; 2]>,
+    flat_out: Vec<f64>,
+    flat_weights: Vec<f64>,
 }
 
 /// The compiled robustness block of one model.
@@ -171,8 +191,13 @@ pub struct RobustModel {
     pub creases: Vec<usize>,
     /// Settings.
     pub spec: RobustSpec,
+    /// The flat layout's edges: every crease (tail, head), then the paper's edges that
+    /// close open facets (as in the exported pattern).
+    pub edges: Vec<[usize; 2]>,
     values: Compiled,
     pullback: Compiled,
+    /// In-plane positions of the flat layout and their Jacobian (issue 20).
+    flat_fn: Compiled,
     n_vertices: usize,
     n_internal: usize,
     t_max: f64,
@@ -208,6 +233,7 @@ impl RobustModel {
         let modes: Vec<Sym> = (0..ni).map(|i| ctx.param(i)).collect();
         let t = ctx.param(ni);
         let flat = geometry::flat(plan, &vars);
+        let flat_ids: Vec<_> = flat.pos.iter().flatten().map(|s| ctx.node_id(s)).collect();
         let folded = geometry::fold(plan, &flat, &modes, &t);
         let x: Vec<[Sym; 3]> = (0..nv)
             .map(|v| geometry::position(plan, &flat, &folded, v))
@@ -252,12 +278,15 @@ impl RobustModel {
             },
         )?;
         let pullback = compile::compile(&graph, &[s_id], nf, n_params, &base)?;
+        let flat_fn = compile::compile(&graph, &flat_ids, nf, n_params, &base)?;
         Ok(RobustModel {
             pairs,
             creases,
             spec,
+            edges: layout_edges(plan),
             values,
             pullback,
+            flat_fn,
             n_vertices: nv,
             n_internal: ni,
             t_max: model.t_max,
@@ -276,9 +305,13 @@ impl RobustModel {
         3 * self.n_vertices + 3 * self.n_internal + self.creases.len()
     }
 
-    /// Sizes and times of the two compiled functions (values, pullback).
-    pub fn reports(&self) -> [&compile::CompileReport; 2] {
-        [&self.values.report, &self.pullback.report]
+    /// Sizes and times of the three compiled functions (values, pullback, flat layout).
+    pub fn reports(&self) -> [&compile::CompileReport; 3] {
+        [
+            &self.values.report,
+            &self.pullback.report,
+            &self.flat_fn.report,
+        ]
     }
 
     /// Buffers sized for this block.
@@ -287,6 +320,9 @@ impl RobustModel {
             params: vec![0.0; self.n_internal + 1 + self.n_weights()],
             out: vec![0.0; self.values.layout.len().max(self.pullback.layout.len())],
             weights: vec![0.0; self.n_weights()],
+            flat: vec![[0.0; 2]; self.n_vertices],
+            flat_out: vec![0.0; self.flat_fn.layout.len()],
+            flat_weights: vec![0.0; 2 * self.n_vertices],
             ..Work::default()
         }
     }
@@ -500,6 +536,132 @@ impl RobustModel {
         }
     }
 
+    /// The smallest feature the flat layout keeps at `level` (paper units), `None` when the
+    /// setting is 0 (off).
+    pub fn feature_required(&self, level: Level) -> Option<f64> {
+        let s = self.spec.settings.min_feature;
+        (s > 0.0).then(|| s * level.factor())
+    }
+
+    /// Number of feature slots: one per vertex pair, then one per vertex and edge (those
+    /// where the vertex is an end of the edge stay unused).
+    pub fn feature_slots(&self) -> usize {
+        let n = self.n_vertices;
+        n * (n - 1) / 2 + n * self.edges.len()
+    }
+
+    /// Evaluate the flat layout (compiled: positions and their Jacobian) into `work.flat`.
+    pub fn eval_flat(&self, free: &[f64], work: &mut Work) {
+        let n = self.n_vertices;
+        self.flat_fn
+            .function
+            .call(free, &work.params, &mut work.flat_out)
+            .expect("buffer sizes match the compiled layout");
+        work.flat.clear();
+        work.flat
+            .extend((0..n).map(|v| [work.flat_out[2 * v], work.flat_out[2 * v + 1]]));
+    }
+
+    /// Visit the feature constraints of the flat layout `pos` at `level` (none when the
+    /// setting is 0): `visit(slot, h, ∂h/∂pos)` with `h = distance − required` and the
+    /// gradient on the two or three vertices involved.
+    pub fn visit_features(
+        &self,
+        pos: &[[f64; 2]],
+        level: Level,
+        mut visit: impl FnMut(usize, f64, &[(usize, [f64; 2])]),
+    ) {
+        let Some(req) = self.feature_required(level) else {
+            return;
+        };
+        let n = pos.len();
+        let unit = |r: [f64; 2], d: f64| {
+            if d > 0.0 {
+                [r[0] / d, r[1] / d]
+            } else {
+                [0.0; 2]
+            }
+        };
+        let mut slot = 0;
+        for a in 0..n {
+            for b in a + 1..n {
+                let r = [pos[a][0] - pos[b][0], pos[a][1] - pos[b][1]];
+                let d = r[0].hypot(r[1]);
+                let u = unit(r, d);
+                visit(slot, d - req, &[(a, u), (b, [-u[0], -u[1]])]);
+                slot += 1;
+            }
+        }
+        for (v, p) in pos.iter().enumerate() {
+            for &[ia, ib] in &self.edges {
+                if v != ia && v != ib {
+                    let (a, b) = (pos[ia], pos[ib]);
+                    let e = [b[0] - a[0], b[1] - a[1]];
+                    let len2 = e[0] * e[0] + e[1] * e[1];
+                    // The nearest point a + s e; with s held there the gradient is exact.
+                    let s = if len2 > 0.0 {
+                        (((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1]) / len2).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
+                    let r = [p[0] - a[0] - s * e[0], p[1] - a[1] - s * e[1]];
+                    let d = r[0].hypot(r[1]);
+                    let u = unit(r, d);
+                    let ga = [-(1.0 - s) * u[0], -(1.0 - s) * u[1]];
+                    let gb = [-s * u[0], -s * u[1]];
+                    visit(slot, d - req, &[(v, u), (ia, ga), (ib, gb)]);
+                }
+                slot += 1;
+            }
+        }
+    }
+
+    /// The feature constraints' augmented-Lagrangian term at `free` with multipliers
+    /// `lambda` (one per feature slot) and penalty `mu`: adds its exact gradient (the
+    /// distances' gradients pulled back through the layout's compiled Jacobian) into `grad`
+    /// and returns its value. 0 when the setting is 0.
+    pub fn feature_merit(
+        &self,
+        free: &[f64],
+        lambda: &[f64],
+        mu: f64,
+        work: &mut Work,
+        grad: &mut [f64],
+    ) -> f64 {
+        if self.feature_required(Level::Imposed).is_none() {
+            return 0.0;
+        }
+        self.eval_flat(free, work);
+        let Work {
+            flat,
+            flat_out,
+            flat_weights: w,
+            ..
+        } = work;
+        w.iter_mut().for_each(|w| *w = 0.0);
+        let mut value = 0.0;
+        self.visit_features(flat, Level::Imposed, |slot, h, dx| {
+            let l = lambda[slot];
+            let a = (l - mu * h).max(0.0);
+            value += (a * a - l * l) / (2.0 * mu);
+            if a > 0.0 {
+                for (v, g) in dx {
+                    w[2 * v] -= a * g[0];
+                    w[2 * v + 1] -= a * g[1];
+                }
+            }
+        });
+        for (k, wk) in w.iter().enumerate().filter(|(_, wk)| **wk != 0.0) {
+            for (g, d) in grad
+                .iter_mut()
+                .zip(&flat_out[self.flat_fn.layout.gradient(k)])
+            {
+                *g += wk * d;
+            }
+        }
+        value
+    }
+
     /// Add `coeff · ∂h/∂(values)` of one constraint into the pullback weights.
     pub fn add_weights(&self, dep: Dep<'_>, coeff: f64, w: &mut [f64]) {
         match dep {
@@ -522,6 +684,17 @@ impl RobustModel {
     }
 }
 
+/// The flat layout's edges: creases, then the paper's edges that close open facets.
+fn layout_edges(plan: &super::plan::Plan) -> Vec<[usize; 2]> {
+    let creases = plan.creases.iter().map(|c| [c.tail, c.head]);
+    let paper = plan
+        .polygons
+        .iter()
+        .filter(|(poly, closed)| !closed && poly.len() >= 2)
+        .map(|(poly, _)| [poly[poly.len() - 1], poly[0]]);
+    creases.chain(paper).collect()
+}
+
 /// One sampled state of a start: its t, planes, multipliers, and whether it is live.
 #[derive(Clone, Debug)]
 struct SampledState {
@@ -541,6 +714,8 @@ pub struct RobustProblem<'a> {
     states: RefCell<Vec<SampledState>>,
     /// The planes that are variables of the current subproblem: (state, pair, offset).
     layout: RefCell<Vec<(usize, usize, usize)>>,
+    /// Multipliers of the flat layout's feature constraints (issue 20), one per slot.
+    feature_lambda: RefCell<Vec<f64>>,
     work: RefCell<Work>,
 }
 
@@ -553,6 +728,7 @@ impl<'a> RobustProblem<'a> {
             modes: modes.to_vec(),
             states: RefCell::new(Vec::new()),
             layout: RefCell::new(Vec::new()),
+            feature_lambda: RefCell::new(Vec::new()),
             work: RefCell::new(block.work()),
         };
         p.reset();
@@ -579,6 +755,38 @@ impl<'a> RobustProblem<'a> {
             st.active.iter_mut().for_each(|a| *a = true);
             st.live = st.t > 0.0;
         }
+        self.feature_lambda
+            .borrow_mut()
+            .iter_mut()
+            .for_each(|l| *l = lambda);
+    }
+
+    /// Update the feature multipliers at `x` (with `mu`); returns the largest violation.
+    fn update_features(&self, x: &[f64], mu: Option<f64>, work: &mut Work) -> f64 {
+        let b = self.block;
+        if b.feature_required(Level::Imposed).is_none() {
+            return 0.0;
+        }
+        b.eval_flat(x, work);
+        let mut lambda = self.feature_lambda.borrow_mut();
+        let mut worst = 0.0_f64;
+        b.visit_features(&work.flat, Level::Imposed, |slot, h, _| {
+            if let Some(mu) = mu {
+                lambda[slot] = (lambda[slot] - mu * h).max(0.0);
+            }
+            worst = worst.max(-h);
+        });
+        worst
+    }
+
+    /// Whether the flat layout at `x` keeps the smallest feature at `level`.
+    pub fn features_hold(&self, x: &[f64], level: Level) -> bool {
+        let mut work = self.work.borrow_mut();
+        self.block.eval_flat(x, &mut work);
+        let mut ok = true;
+        self.block
+            .visit_features(&work.flat, level, |_, h, _| ok &= h >= -1e-12);
+        ok
     }
 
     /// The planes that are variables of the current subproblem (after
@@ -641,6 +849,7 @@ impl Robust for RobustProblem<'_> {
         *self.states.borrow_mut() = (0..n)
             .map(|i| self.new_state(self.model.t_max * i as f64 / (n - 1) as f64))
             .collect();
+        *self.feature_lambda.borrow_mut() = vec![0.0; self.block.feature_slots()];
     }
 
     fn update(&self, x: &[f64], mu: Option<f64>) -> f64 {
@@ -666,7 +875,7 @@ impl Robust for RobustProblem<'_> {
             worst = worst.max(w);
             st.live = live;
         }
-        worst
+        worst.max(self.update_features(x, mu, &mut work))
     }
 
     fn variables(&self) -> Vec<f64> {
@@ -769,10 +978,15 @@ impl Robust for RobustProblem<'_> {
                 work.weights = w;
             }
         }
-        value
+        let lambda = self.feature_lambda.borrow();
+        value + b.feature_merit(x, &lambda, mu, &mut work, grad_x)
     }
 
     fn accept(&self, x: &[f64]) -> Acceptance {
+        // The flat layout is the same at every t: more states cannot fix a sliver.
+        if !self.features_hold(x, Level::Accept) {
+            return Acceptance::Rejected;
+        }
         let b = self.block;
         let n = b.spec.sweep;
         let np = b.pairs.pairs.len();

@@ -477,6 +477,7 @@ fn measure_robustness(
         tip,
         t_max: model.t_max,
         settings: task.robustness,
+        arm,
     };
     robustness::measure(&input).map_err(|e| e.to_string())
 }
@@ -968,6 +969,7 @@ pub fn finish(
                 "rigid_margin": task.robustness.rigid_margin,
                 "clearance": task.robustness.clearance,
                 "obstacle_clearance": task.robustness.obstacle_clearance,
+                "min_feature": task.robustness.min_feature,
             },
         }),
         meets_margins: tally.meets_margins,

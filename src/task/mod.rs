@@ -42,7 +42,9 @@ use serde::Deserialize;
 pub use drive::Drive;
 pub use initial::{InitialCrease, InitialGraph, InitialVertex};
 pub use number::Number;
-pub use robustness::{DEFAULT_CLEARANCE, DEFAULT_RIGID_MARGIN, MAX_RIGID_MARGIN, Robustness};
+pub use robustness::{
+    DEFAULT_CLEARANCE, DEFAULT_MIN_FEATURE, DEFAULT_RIGID_MARGIN, MAX_RIGID_MARGIN, Robustness,
+};
 
 use crate::grammar::VertexType;
 
