@@ -3,8 +3,10 @@
 //! Newton's polish brings a cell nudged off a compatible family back onto one.
 
 use foldsynth::check::cycle::{CYCLE_TOL, verify_cycles};
+use foldsynth::check::verify::{Tolerances, verify};
 use foldsynth::compile::Options;
 use foldsynth::grammar::CreaseGraph;
+use foldsynth::kinematics::closure_residual;
 use foldsynth::model::compiled::{CompiledModel, ModelProblem, outputs_f64};
 use foldsynth::model::numeric::{Evaluated, sample_times};
 use foldsynth::model::{Model, cycle, geometry};
@@ -207,4 +209,79 @@ fn a_crease_folding_through_flat_fails_the_sweep() {
     let miura = Evaluated::new(&c.plan, c.full_vars(&miura_free(&c)), MIURA_MODES.to_vec());
     let r = verify_cycles(&miura, &ts, 1e-12);
     assert!(r.through_flat.is_none(), "{r:?}");
+}
+
+/// A design of `synthesize grammar/gripper.toml --rules r1,r2,r2p` (`model --graph
+/// "2, 3, 8, (4, 11)'" --candidate 2 --modes down,down,up --optimize`): cyclic, compatible
+/// to 2e-13 over the sweep, and at t = 0 every vertex triangle has perimeter 2π (each
+/// unit spans at most π), where the PTU's θ come from sin s ≈ 1e-16 and its φ are ~1e-7
+/// of noise. The flat state of a cyclic design is flat by definition (every fold angle 0);
+/// its vertex states must say so too, or closure, measured on fold angles and φ together,
+/// fails by that noise (it did: 8.6e-8 against 1e-10, counted as a verification failure).
+#[test]
+fn the_flat_state_of_a_cyclic_design_closes_exactly() {
+    let task = Task::load(concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper.toml")).unwrap();
+    let g = CreaseGraph::from_sequence(&task, "2, 3, 8, (4, 11)'").unwrap();
+    let m = Model::new(&g, &task, 1).unwrap();
+    let vars: [(&str, f64); 10] = [
+        ("α_3", 1.7727240987035973),
+        ("l_2,3", 0.20099461765543536),
+        ("α_5", 0.34988032748083936),
+        ("α_6", 0.9673436594046511),
+        ("α_7", 2.967042900988319),
+        ("α_8", 0.17456692753679198),
+        ("l_3,8", 0.3949348113626515),
+        ("α_9", 2.074580258477363),
+        ("α_10", 2.9662694348862426),
+        ("l_8,10", 1.4999120281956797),
+    ];
+    let free: Vec<f64> = m
+        .free
+        .iter()
+        .map(|&i| {
+            let name = &m.plan.variables[i].name;
+            vars.iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, v)| *v)
+                .unwrap_or_else(|| panic!("no value for {name}"))
+        })
+        .collect();
+    let modes = vec![-1.0, -1.0, 1.0];
+    let d = Evaluated::new(&m.plan, m.full_vars(&free), modes.clone());
+
+    // The PTU itself at t = 0: perimeter 2π at every vertex, φ off zero by noise.
+    let raw = geometry::fold(&m.plan, &d.flat, &modes, &0.0);
+    let noisy = m.plan.internal.iter().any(|&a| {
+        let st = raw.states[a].as_ref().unwrap();
+        let s = (st.u[0] + st.u[1] + st.u[2]) / 2.0;
+        assert!((s - PI).abs() < 1e-14, "{:?}", st.u);
+        st.phi.iter().any(|p| p.abs() > 1e-9)
+    });
+    assert!(
+        noisy,
+        "the case this test is about: φ at the flat state is noise"
+    );
+
+    // The design's flat state: fold angles 0 and, at every vertex, φ equal to the fold
+    // angles of its three outgoing creases, closing the loop to rounding.
+    let flat = d.fold(0.0);
+    let rho: Vec<Option<f64>> = flat.rho.iter().map(|r| Some(*r)).collect();
+    for &a in &m.plan.internal {
+        let st = flat.states[a].as_ref().unwrap();
+        let v = &m.plan.vertices[a];
+        for (slot, phi) in [(0, 2), (1, 0), (2, 1)] {
+            assert_eq!(st.phi[phi], flat.rho[v.rays[v.preds + slot].crease]);
+        }
+        let u = geometry::units(&m.plan, &d.flat, &rho, a).unwrap();
+        let c = closure_residual(&u, &st.phi);
+        assert!(c < 1e-14, "v{}: closure {c:e}", v.name);
+    }
+
+    // So the whole verification passes, the flat state included.
+    let ts = sample_times(m.t_max, 181);
+    let tol = Tolerances::default();
+    let v = verify(&d, &ts, &tol);
+    assert_eq!(v.rigid_states, ts.len(), "{v:?}");
+    assert!(v.passes(&tol), "{:?}", v.failures(&tol));
+    assert!(verify_cycles(&d, &ts, 1e-12).passes(CYCLE_TOL));
 }

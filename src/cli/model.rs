@@ -189,6 +189,11 @@ pub fn run(args: ModelArgs) -> Result<()> {
             starts: args.starts,
             seed: args.seed,
             target: Some(objective_target(&model)),
+            max_outer: if model.plan.sinks.is_empty() {
+                crate::optimize::Options::default().max_outer
+            } else {
+                crate::model::cycle::MAX_OUTER
+            },
             ..Default::default()
         };
         let t0 = std::time::Instant::now();

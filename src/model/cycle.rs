@@ -41,6 +41,13 @@ use crate::kinematics::Scalar;
 /// without matching the whole motion is unlikely; the dense sweep judges anyway.
 pub const CYCLE_STATES: usize = 6;
 
+/// Augmented-Lagrangian iterations per start for a cyclic model (the optimizer's default
+/// is 10): its 8 equalities per sink and state, each a pair of inequalities, need more
+/// multiplier updates. Measured on `grammar/miura.toml` (`2, 3, 4, 8, (9, 14)'`, candidate
+/// 2, modes down,up,up,down, Kawasaki's condition): with 10, 32 starts end infeasible at
+/// Ω = 0.39 at best; with 30, the 4th start meets the target.
+pub const MAX_OUTER: usize = 30;
+
 /// Constraints per sink and state: the dihedral pair, then three position pairs.
 pub const PER_STATE: usize = 8;
 

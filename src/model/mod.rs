@@ -87,6 +87,8 @@ pub struct Model {
     /// The distinct values of t the model evaluates: `t_max` first, then the targets', then
     /// (for cyclic patterns) the compatibility states of [`cycle::states`].
     pub times: Vec<f64>,
+    /// The task's `[constraints] kawasaki`: every internal vertex of even degree folds flat.
+    pub kawasaki: bool,
 }
 
 impl Model {
@@ -156,6 +158,7 @@ impl Model {
             gripping,
             free: Vec::new(),
             times,
+            kawasaki: task.kawasaki,
         };
         model.free = model.dependencies();
         Ok(model)
@@ -239,6 +242,7 @@ impl Model {
         };
         let mut constraints = self.constraints(&flat, &folded[0]);
         constraints.extend(cycle::constraints(self, &flat, &folded));
+        constraints.extend(self.kawasaki_constraints(&flat));
         Outputs {
             objective,
             constraints,
@@ -286,6 +290,46 @@ impl Model {
             .collect()
     }
 
+    /// The internal vertices Kawasaki's condition applies to: all of even degree when the
+    /// task asks for it (an odd-degree vertex, r2's, cannot fold flat at all).
+    pub fn kawasaki_vertices(&self) -> Vec<usize> {
+        if !self.kawasaki {
+            return Vec::new();
+        }
+        let p = &self.plan;
+        p.internal
+            .iter()
+            .copied()
+            .filter(|&v| p.vertices[v].rays.len().is_multiple_of(2))
+            .collect()
+    }
+
+    /// Kawasaki's condition as constraints `g ≥ 0`: at each of [`Model::kawasaki_vertices`]
+    /// the alternating sum of the flat sectors, `Σ (−1)^k α_k = 0`, as the pair `±`. With
+    /// the sum 2π it says every other sector sums to π: the vertex folds flat. On a cyclic
+    /// pattern of degree-4 vertices this turns the compatibility of the whole motion into
+    /// one condition: a flat-foldable vertex's fold angles obey `tan(ρ_i/2) = k_i
+    /// tan(ρ_j/2)` with constant k_i, so around a cycle the products either agree for
+    /// every t or for none.
+    pub fn kawasaki_constraints<S: Scalar>(&self, flat: &Flat<S>) -> Vec<S> {
+        let mut out = Vec::new();
+        for v in self.kawasaki_vertices() {
+            let sum = flat.sectors[v]
+                .iter()
+                .enumerate()
+                .fold(S::from_f64(0.0), |acc, (k, a)| {
+                    if k.is_multiple_of(2) {
+                        acc + a.clone()
+                    } else {
+                        acc - a.clone()
+                    }
+                });
+            out.push(sum.clone());
+            out.push(-sum);
+        }
+        out
+    }
+
     /// Ω as the thesis states it (Eq. 37/38): `Σ w ‖P − X_g(t)‖`, from the f64 path.
     pub fn omega(&self, full_vars: &[f64], modes: &[f64]) -> f64 {
         let flat = geometry::flat(&self.plan, full_vars);
@@ -310,6 +354,14 @@ impl Model {
             && j < cycle::count(self)
         {
             return cycle::label(self, j);
+        }
+        if let Some(j) = i.checked_sub(p.constraints.len() + cycle::count(self)) {
+            let v = self.kawasaki_vertices()[j / 2];
+            return format!(
+                "Kawasaki: v{} folds flat, alternating sector sum {} 0",
+                p.vertices[v].name,
+                if j % 2 == 0 { "≥" } else { "≤" }
+            );
         }
         match &p.constraints[i] {
             Constraint::Sector {

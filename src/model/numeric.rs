@@ -5,7 +5,7 @@
 use super::geometry::{self, Flat, Folded};
 use super::linalg;
 use super::plan::Plan;
-use crate::kinematics::wrap_angle;
+use crate::kinematics::{solve_vertex, wrap_angle};
 use crate::pattern::{Edge, EdgeKind, Frame, Pattern};
 
 /// A design evaluated numerically: the flat pattern and any number of folded states.
@@ -50,6 +50,21 @@ impl<'a> Evaluated<'a> {
             folded.rho.iter_mut().for_each(|r| *r = 0.0);
             folded.rot.iter_mut().for_each(|r| *r = linalg::identity());
             folded.trans.iter_mut().for_each(|c| *c = [0.0; 3]);
+            // The vertex states must describe that configuration too: with a vertex
+            // triangle of perimeter 2π (s = π), sin s is rounding (~1e-16), so the PTU's
+            // θ miss π by √ε and its φ are ~1e-8 of noise, which the next vertex takes as
+            // its driving angle. Left in place, they disagree with the zeroed fold angles
+            // and closure, measured on both, fails by that noise (issue 19: 8.6e-8 at t = 0
+            // for a gripper design). Re-solve every vertex on the zeroed driving angles
+            // and take the flat state's φ = 0.
+            let rho: Vec<Option<f64>> = folded.rho.iter().map(|r| Some(*r)).collect();
+            for (k, &a) in self.plan.internal.iter().enumerate() {
+                let units = geometry::units(self.plan, &self.flat, &rho, a)
+                    .expect("every fold angle is set");
+                let mut st = solve_vertex(&units, &self.modes[k]);
+                st.phi = [0.0; 3];
+                folded.states[a] = Some(st);
+            }
         }
         folded
     }

@@ -252,6 +252,11 @@ fn evaluate(
         starts: opts.starts,
         seed: alternative_seed(opts.seed, &key),
         target: Some(objective_target(model)),
+        max_outer: if model.plan.sinks.is_empty() {
+            optimize::Options::default().max_outer
+        } else {
+            crate::model::cycle::MAX_OUTER
+        },
         ..Default::default()
     };
     let mut sol = match &p.robust {

@@ -3,8 +3,9 @@
 //! A task file holds the initial graph G0 (vertices with in-plane coordinates and types,
 //! creases with their facet labels and driving angles), the grammar's limit N_max, the
 //! task's symmetry, and the design task the later stages use: the motion range, the
-//! variable bounds, the objective (points to reach at given t) and the intersection-check
-//! setup (thesis Sec. 5.1, 5.5; SPEC §4). Every field is checked on load; a bad file gets a
+//! variable bounds, the objective (points to reach at given t), the intersection-check
+//! setup (thesis Sec. 5.1, 5.5; SPEC §4) and optional design constraints (`[constraints]
+//! kawasaki = true`: flat-foldable vertices). Every field is checked on load; a bad file gets a
 //! [`TaskError`] naming the file, the field and what is allowed.
 //!
 //! ```toml
@@ -90,6 +91,9 @@ pub struct Task {
     /// Margins the optimizer keeps over the whole motion (`[robustness]`, defaults when
     /// absent).
     pub robustness: Robustness,
+    /// `[constraints] kawasaki = true`: every internal vertex of even degree folds flat
+    /// (Kawasaki's condition, imposed by the model); off when absent.
+    pub kawasaki: bool,
 }
 
 /// Symmetry of a design task.
@@ -184,6 +188,14 @@ struct RawTask {
     objective: Option<RawObjective>,
     check: Option<RawCheck>,
     robustness: Option<robustness::RawRobustness>,
+    constraints: Option<RawConstraints>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawConstraints {
+    #[serde(default)]
+    kawasaki: bool,
 }
 
 #[derive(Deserialize)]
@@ -595,6 +607,7 @@ impl Task {
             objective,
             check,
             robustness,
+            kawasaki: raw.constraints.is_some_and(|c| c.kawasaki),
         })
     }
 }
