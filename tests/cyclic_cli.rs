@@ -50,6 +50,30 @@ fn model(vars: &Path, save: &Path) -> (bool, String) {
     )
 }
 
+/// Export a design file as FOLD and check that `verify` passes it.
+fn export_fold_and_verify(design: &Path, fold: &Path) {
+    let out = foldsynth(&[
+        "export",
+        design.to_str().unwrap(),
+        "--format",
+        "fold",
+        "--out",
+        fold.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = foldsynth(&["verify", fold.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 #[test]
 fn the_miura_cell_is_saved_exported_and_verified() {
     let dir = tempfile::tempdir().unwrap();
@@ -71,26 +95,7 @@ fn the_miura_cell_is_saved_exported_and_verified() {
     assert_eq!(doc["cycle"]["passes"], true);
     assert_eq!(doc["pattern"]["frames"].as_array().unwrap().len(), 33);
 
-    let out = foldsynth(&[
-        "export",
-        design.to_str().unwrap(),
-        "--format",
-        "fold",
-        "--out",
-        fold.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let out = foldsynth(&["verify", fold.to_str().unwrap()]);
-    assert!(
-        out.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    export_fold_and_verify(&design, &fold);
     let out = foldsynth(&["simulate", design.to_str().unwrap(), "--json"]);
     assert!(
         out.status.success(),
@@ -191,24 +196,5 @@ fn the_optimizer_finds_a_flat_foldable_cell_on_the_miura_task() {
     }
     eprintln!("Ω = {omega:.3e}; vertices with the Miura-ori's symmetry: {mirror:?}");
 
-    let out = foldsynth(&[
-        "export",
-        design.to_str().unwrap(),
-        "--format",
-        "fold",
-        "--out",
-        fold.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let out = foldsynth(&["verify", fold.to_str().unwrap()]);
-    assert!(
-        out.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    export_fold_and_verify(&design, &fold);
 }

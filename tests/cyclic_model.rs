@@ -36,6 +36,20 @@ fn miura_free(m: &Model) -> Vec<f64> {
 
 const MIURA_MODES: [f64; 4] = [-1.0, 1.0, 1.0, -1.0];
 
+/// The model's free variables in its order, from named values (every one must be given).
+fn free_values(m: &Model, vars: &[(&str, f64)]) -> Vec<f64> {
+    m.free
+        .iter()
+        .map(|&i| {
+            let name = &m.plan.variables[i].name;
+            vars.iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, v)| *v)
+                .unwrap_or_else(|| panic!("no value for {name}"))
+        })
+        .collect()
+}
+
 #[test]
 fn the_cycle_constraints_are_in_the_model() {
     let m = model(0);
@@ -179,17 +193,7 @@ fn a_crease_folding_through_flat_fails_the_sweep() {
         ("α_8", 2.9669575201189273),
         ("α_9", 2.7363488524356057),
     ];
-    let free: Vec<f64> = m
-        .free
-        .iter()
-        .map(|&i| {
-            let name = &m.plan.variables[i].name;
-            vars.iter()
-                .find(|(n, _)| n == name)
-                .map(|(_, v)| *v)
-                .unwrap_or_else(|| panic!("no value for {name}"))
-        })
-        .collect();
+    let free = free_values(&m, &vars);
     let ts = sample_times(m.t_max, 181);
     let d = Evaluated::new(&m.plan, m.full_vars(&free), vec![-1.0, 1.0, 1.0, 1.0]);
     let r = verify_cycles(&d, &ts, 1e-12);
@@ -235,17 +239,7 @@ fn the_flat_state_of_a_cyclic_design_closes_exactly() {
         ("α_10", 2.9662694348862426),
         ("l_8,10", 1.4999120281956797),
     ];
-    let free: Vec<f64> = m
-        .free
-        .iter()
-        .map(|&i| {
-            let name = &m.plan.variables[i].name;
-            vars.iter()
-                .find(|(n, _)| n == name)
-                .map(|(_, v)| *v)
-                .unwrap_or_else(|| panic!("no value for {name}"))
-        })
-        .collect();
+    let free = free_values(&m, &vars);
     let modes = vec![-1.0, -1.0, 1.0];
     let d = Evaluated::new(&m.plan, m.full_vars(&free), modes.clone());
 

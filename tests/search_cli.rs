@@ -5,9 +5,13 @@
 //! errors.
 
 use serde_json::Value;
-use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
+
+#[path = "common/runs.rs"]
+#[allow(dead_code)] // only the records reader is used here
+mod runs;
+use runs::records;
 
 const GRIPPER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper.toml");
 
@@ -25,20 +29,6 @@ fn synthesize(out: &Path, extra: &[&str]) -> Value {
     let r = foldsynth(&args);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     serde_json::from_slice(&r.stdout).unwrap()
-}
-
-/// The records of a run by key, without the timing fields.
-fn records(out: &Path) -> BTreeMap<String, Value> {
-    let text = std::fs::read_to_string(out.join("alternatives.jsonl")).unwrap();
-    text.lines()
-        .map(|l| {
-            let mut v: Value = serde_json::from_str(l).unwrap();
-            let m = v.as_object_mut().unwrap();
-            m.remove("optimize_ms");
-            m.remove("check_ms");
-            (m["key"].as_str().unwrap().to_string(), v)
-        })
-        .collect()
 }
 
 fn counts(s: &Value) -> Vec<u64> {
