@@ -182,3 +182,83 @@ fn single_sector_units_have_no_start_or_end_angle() {
     let a = unit_angles(&Unit::single(1.1_f64));
     assert_eq!((a.u, a.beta, a.delta), (1.1, 0.0, 0.0));
 }
+
+/// A degree-4 vertex whose two-sector unit is degenerate: folded onto itself
+/// (`ρ → ±π` with equal sectors, `U1 → 0`) or straight (`ρ → 0` with sectors summing to
+/// π, `U1 → π`), the other two sectors chosen so the vertex stays (barely) rigid.
+fn degenerate_unit_vertex() -> impl Strategy<Value = [Unit<f64>; 3]> {
+    (
+        0.3f64..1.4,
+        -12.0f64..-5.0,
+        -1.0f64..1.0,
+        -12.0f64..-5.0,
+        any::<bool>(),
+        any::<bool>(),
+    )
+        .prop_map(|(x, e1, f, e3, folded, sign)| {
+            let (e1, e3) = (10f64.powf(e1), 10f64.powf(e3));
+            let s = if sign { 1.0 } else { -1.0 };
+            let (a, b, rho) = if folded {
+                (x, x + e1, s * (PI - e3))
+            } else {
+                (x, PI - x - e1, s * e3)
+            };
+            // c ≈ d within the unit angle, so that U1 + U3 − U2 and U1 + U2 − U3 stay ≥ 0.
+            let c = (2.0 * PI - a - b) / 2.0 + f * e1 / 4.0;
+            let d = 2.0 * PI - a - b - c;
+            [
+                Unit::new(vec![a, b], vec![rho]),
+                Unit::single(c),
+                Unit::single(d),
+            ]
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+
+    /// Closure where a unit angle vanishes or reaches π. There the start and end angles
+    /// are each defined only to ε / sin U, so they must be read as one decomposition of
+    /// the unit's rotation: read apart, the residual was 1e-9 (the robotic arm's
+    /// alternative `2, 4, 6, (3, 9), (6, 10)`, candidate 2, up-down-up).
+    #[test]
+    fn closure_holds_where_a_unit_angle_vanishes(units in degenerate_unit_vertex(), up in any::<bool>()) {
+        let mode = if up { 1.0 } else { -1.0 };
+        let v = solve_vertex(&units, &mode);
+        prop_assume!(v.margins.iter().all(|m| *m >= 0.0));
+        let r = closure_residual(&units, &v.phi);
+        prop_assert!(r <= 1e-13, "residual {} for {:?} mode {} (U {:?})", r, units, mode, v.u);
+    }
+}
+
+/// The two vertices of the robotic arm's alternative `2, 4, 6, (3, 9), (6, 10)`
+/// (candidate 2, up-down-up) whose closure was 2e-9, as the verification sweep met them:
+/// a unit straight at t = 0 (U = π − 2e-8) and one folded onto itself (U = 4e-7).
+#[test]
+fn closure_holds_at_the_robotic_arm_vertices_that_lost_precision() {
+    let cases = [
+        [
+            Unit::new(
+                vec![2.5195482875069586, 0.6220443675872769],
+                vec![4.2012760381737735e-8],
+            ),
+            Unit::single(0.6220442473101857),
+            Unit::single(2.519548404775165),
+        ],
+        [
+            Unit::new(
+                vec![0.6844795930018897, 0.6844797539848414],
+                vec![-3.141593167484853],
+            ),
+            Unit::single(2.4571129010018558),
+            Unit::single(2.4571130591909993),
+        ],
+    ];
+    for units in cases {
+        for mode in [1.0, -1.0] {
+            let v = solve_vertex(&units, &mode);
+            let r = closure_residual(&units, &v.phi);
+            assert!(r <= 1e-14, "residual {r} for {units:?} mode {mode}");
+        }
+    }
+}

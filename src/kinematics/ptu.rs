@@ -96,7 +96,8 @@ fn chain<S: Scalar>(sectors: &[S], driving: &[S]) -> [[S; 3]; 3] {
 ///   `+e_y`, since `0 < α_1 < π`) and the arc to `P_m` (tangent `(0, y, z)`), so
 ///   `−sgn(z)·acos(…) = −atan2(z, y)`; at `z = 0` this gives `±π` where `sgn(0) = 0`
 ///   would lose a half turn (a flat unit whose sectors sum past π); the end angle is the
-///   mirror image on the reversed chain, `−atan2(z', −y')`;
+///   mirror image on the reversed chain (Eq. 21–22), read off `Q` consistently with the
+///   start angle (see the comment in the body);
 /// - `U = atan2(√(y² + z²), x)` keeps full precision near 0 and π where `acos` loses
 ///   half the digits.
 pub fn unit_angles<S: Scalar>(unit: &Unit<S>) -> UnitAngles<S> {
@@ -108,15 +109,19 @@ pub fn unit_angles<S: Scalar>(unit: &Unit<S>) -> UnitAngles<S> {
             delta: S::from_f64(0.0),
         };
     }
-    let [[x, r01, r02], [y, _, _], [z, _, _]] = chain(sectors, driving);
-    let u = (y.clone() * y.clone() + z.clone() * z.clone())
-        .sqrt()
-        .atan2(&x);
+    let [[x, _, _], [y, q11, q12], [z, q21, q22]] = chain(sectors, driving);
+    let r = (y.clone() * y.clone() + z.clone() * z.clone()).sqrt();
+    let u = r.atan2(&x);
     let beta = -z.atan2(&y);
-    // End angle: the same construction on the reversed chain P'_0 = (x, r01, r02). There
-    // the arc to P'_{m-1} = R_z(-α_m) e_x leaves e_x along -e_y (the reversed chain turns
-    // clockwise), so the angle between the arcs is atan2(|z'|, -y').
-    let delta = -r02.atan2(&-r01);
+    // End angle. Q = R_x(−β) R_z(U) R_x(−δ) (an X-Z-X Euler decomposition), so the last
+    // row of R_x(β) Q is (0, −sin δ, cos δ). Reading δ there, with the β just computed,
+    // keeps (U, β, δ) one consistent decomposition of Q even where β and δ are each
+    // ill-defined (U → 0 or π, a unit folded onto itself or straight): reading δ from
+    // Q's first row instead gives β and δ independent errors of ε/sin U, and closure
+    // residuals of 1e-9 at such vertices. (cos β, −sin β) ∝ (y, z); at y = z = 0 the
+    // direction is taken as (1, 0), β's own value there.
+    let yy = y.clone() + (S::from_f64(1.0) - r.sgn());
+    let delta = -(yy.clone() * q21 - z.clone() * q11).atan2(&(yy * q22 - z * q12));
     UnitAngles { u, beta, delta }
 }
 
