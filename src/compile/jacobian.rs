@@ -58,9 +58,50 @@ pub fn jacobian(
     })
 }
 
+/// `1/y`: the one division by `y` that every partial dividing by `y` shares (hash-consed
+/// across the reverse sweep and the elimination). Divisions are the slowest arithmetic in
+/// the generated code (on the gripper's design model the gradients had 59 divisions by
+/// 30 distinct denominators); a reciprocal and a product round twice, within 1 ulp of the
+/// quotient.
+pub(crate) fn recip(g: &mut ExprGraph, y: NodeId) -> NodeId {
+    let one = g.constant(1.0);
+    g.add(Node::Div(one, y))
+}
+
+/// `1/r` where `r = x² + y² > 0`, else 0: `atan2(y, x)`'s partials are `(x, −y)` times it.
+pub(crate) fn atan2_weight(g: &mut ExprGraph, y: NodeId, x: NodeId) -> NodeId {
+    let xx = g.add(Node::Mul(x, x));
+    let yy = g.add(Node::Mul(y, y));
+    let r = g.add(Node::Add(xx, yy));
+    let q = recip(g, r);
+    let zero = g.constant(0.0);
+    g.add(Node::Select(r, q, zero))
+}
+
+/// `a · w` where either factor may be an indicator `select(c, 1, 0)` (or
+/// `select(c, 0, 1)`): then the other factor is routed by the select instead of
+/// multiplied, which saves the product and keeps a discarded non-finite factor from
+/// turning `0 · ∞` into NaN.
+pub(crate) fn scale(g: &mut ExprGraph, a: NodeId, w: NodeId) -> NodeId {
+    for (s, t) in [(a, w), (w, a)] {
+        if let Node::Select(c, u, v) = *g.node(s) {
+            let (u1, v0) = (g.const_value(u), g.const_value(v));
+            if u1 == Some(1.0) && v0 == Some(0.0) {
+                return g.add(Node::Select(c, t, v));
+            }
+            if u1 == Some(0.0) && v0 == Some(1.0) {
+                return g.add(Node::Select(c, u, t));
+            }
+        }
+    }
+    g.add(Node::Mul(a, w))
+}
+
 /// The local partials `(child, ∂node/∂child)` of node `id` for the children that depend
-/// on a variable (a child appearing twice gets the sum).
-fn partials(g: &mut ExprGraph, id: NodeId, dep: &[bool]) -> Vec<(usize, NodeId)> {
+/// on a variable (a child appearing twice gets the sum). They do not depend on the
+/// adjoint, so the reverse sweep of [`super::diff`] (which multiplies them by it) and
+/// the elimination share them.
+pub(crate) fn partials(g: &mut ExprGraph, id: NodeId, dep: &[bool]) -> Vec<(usize, NodeId)> {
     let node = *g.node(id);
     let one = g.constant(1.0);
     let mone = g.constant(-1.0);
@@ -74,9 +115,10 @@ fn partials(g: &mut ExprGraph, id: NodeId, dep: &[bool]) -> Vec<(usize, NodeId)>
         Node::Mul(x, y) => out.extend([(x, y), (y, x)]),
         Node::Div(x, y) => {
             // d(x/y) = dx/y − (x/y)·dy/y
-            out.push((x, g.add(Node::Div(one, y))));
+            let r = recip(g, y);
+            out.push((x, r));
             if dep[y.index()] {
-                let q = g.add(Node::Div(id, y));
+                let q = g.add(Node::Mul(id, r));
                 out.push((y, g.add(Node::Neg(q))));
             }
         }
@@ -89,21 +131,19 @@ fn partials(g: &mut ExprGraph, id: NodeId, dep: &[bool]) -> Vec<(usize, NodeId)>
             // −1/√p where p = (1 − c)(1 + c) > 0, else 0.
             let p = one_minus_sq_node(g, x);
             let r = g.add(Node::Sqrt(p));
-            let q = g.add(Node::Div(mone, r));
+            let r = recip(g, r);
+            let q = g.add(Node::Neg(r));
             out.push((x, g.add(Node::Select(p, q, zero))));
         }
         Node::Sqrt(x) => {
+            // 0.5/√x where √x > 0, else 0.
             let half = g.constant(0.5);
-            let q = g.add(Node::Div(half, id));
+            let r = recip(g, id);
+            let q = g.add(Node::Mul(half, r));
             out.push((x, g.add(Node::Select(id, q, zero))));
         }
         Node::Atan2(y, x) => {
-            // (x, −y)/r, r = x² + y², where r > 0, else 0.
-            let xx = g.add(Node::Mul(x, x));
-            let yy = g.add(Node::Mul(y, y));
-            let r = g.add(Node::Add(xx, yy));
-            let q = g.add(Node::Div(one, r));
-            let w = g.add(Node::Select(r, q, zero));
+            let w = atan2_weight(g, y, x);
             if dep[y.index()] {
                 out.push((y, g.add(Node::Mul(w, x))));
             }
@@ -225,7 +265,7 @@ fn eliminate(g: &mut ExprGraph, outputs: &[NodeId], n_vars: usize) -> Vec<Vec<No
         for &s in &ss {
             let w_vs = lin.preds[s].remove(&v).expect("edge v → s");
             for &(p, w_pv) in &ps {
-                let m = g.add(Node::Mul(w_pv, w_vs));
+                let m = scale(g, w_pv, w_vs);
                 let w = match lin.preds[s].get(&p) {
                     Some(&e) => g.add(Node::Add(e, m)),
                     None => m,
