@@ -576,14 +576,14 @@ fn fusable_products(
         uses[o.index()] += 1;
     }
     for (i, n) in nodes.iter().enumerate().skip(fuse_from) {
-        if mark[i] && matches!(n, Node::Add(..) | Node::Sub(..)) {
-            if let Some(c) = n
+        if mark[i]
+            && matches!(n, Node::Add(..) | Node::Sub(..))
+            && let Some(c) = n
                 .children()
                 .into_iter()
                 .find(|c| uses[c.index()] == 1 && matches!(nodes[c.index()], Node::Mul(..)))
-            {
-                fused[c.index()] = true;
-            }
+        {
+            fused[c.index()] = true;
         }
     }
     fused
