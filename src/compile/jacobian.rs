@@ -11,13 +11,14 @@
 //! vertex with the fewest `preds × succs` products first.
 //!
 //! Measured on the gripper task's 159 design models (objective first, then the
-//! constraints): reverse sweeps for the objective and elimination for the constraints
-//! ([`Jacobian::Auto`]) compile 37% fewer operations than reverse sweeps for all, and the
-//! compiled code runs and compiles about a quarter faster; on the robotic arm's (whose
-//! objective dominates) 7% fewer.
+//! constraints): a reverse sweep for the objective and elimination for the constraints
+//! compile 37% fewer operations than reverse sweeps for all, and the compiled code runs
+//! and compiles about a quarter faster; on the robotic arm's (whose objective dominates)
+//! 7% fewer. Elimination for the objective too is smaller again on some models and much
+//! larger on others, so [`Jacobian::Auto`] builds both and keeps the smaller.
 //!
-//! The local partials and their guards are exactly [`super::diff`]'s, so both have the
-//! same NaN behaviour (see its docs).
+//! The local partials and their guards are the reverse sweep's too ([`partials`] is
+//! shared), so both have the same NaN behaviour (see [`super::diff`]'s docs).
 
 use super::diff::{gradients, one_minus_sq_node};
 use crate::expr::{ExprGraph, Node, NodeId, ShapeError, check_indices};
