@@ -17,7 +17,7 @@
 //! 7% fewer. Elimination for the objective too is smaller again on some models and much
 //! larger on others, so [`Jacobian::Auto`] builds both and keeps the smaller.
 //!
-//! The local partials and their guards are the reverse sweep's too ([`partials`] is
+//! The local partials and their guards are the reverse sweep's too (one function is
 //! shared), so both have the same NaN behaviour (see [`super::diff`]'s docs).
 
 use super::diff::{gradients, one_minus_sq_node};
