@@ -421,6 +421,14 @@ impl<'a> Scene<'a> {
         Self::check_size(size)?;
         let mut pm = Pixmap::new(size.0, size.1)
             .ok_or_else(|| ExportError::Image("cannot allocate the image".into()))?;
+        self.draw(&mut pm, frame);
+        Ok(pm)
+    }
+
+    /// Draw one state over the whole of `pm` (cleared to white first), so a caller
+    /// drawing many states can reuse one pixmap.
+    fn draw(&self, pm: &mut Pixmap, frame: Option<usize>) {
+        let size = (pm.width(), pm.height());
         pm.fill(Color::WHITE);
         let fit = self.fit(size);
         let paint_of = |c: Rgba| {
@@ -512,8 +520,7 @@ impl<'a> Scene<'a> {
                 }
             }
         }
-        self.draw_axes(&mut pm, size);
-        Ok(pm)
+        self.draw_axes(pm, size);
     }
 
     fn axes_lines(&self, size: (u32, u32)) -> Vec<([f64; 2], [f64; 2], Rgba, &'static str)> {
@@ -594,18 +601,24 @@ impl<'a> Scene<'a> {
         let picked = super::picked_frames(total, max_frames.max(2));
         let n = picked.len();
         let palette = gif_palette();
+        let blank = || {
+            Pixmap::new(size.0, size.1)
+                .ok_or_else(|| ExportError::Image("cannot allocate the image".into()))
+        };
         let drawn: Vec<(Vec<u8>, Option<Vec<u8>>)> = picked
             .par_iter()
             .enumerate()
-            .map(|(k, &frame_index)| -> Result<(Vec<u8>, Option<Vec<u8>>)> {
-                let mut pm = self.pixmap(Some(frame_index), size)?;
+            // One pixmap per worker, redrawn for each of its frames.
+            .map_init(blank, |pm, (k, &frame_index)| {
+                let pm = pm.as_mut().map_err(|e| ExportError::Image(e.to_string()))?;
+                self.draw(pm, Some(frame_index));
                 let png = if pictures.contains(&frame_index) {
-                    Some(encode_png(&pm)?)
+                    Some(encode_png(pm)?)
                 } else {
                     None
                 };
-                draw_progress(&mut pm, k, n);
-                Ok((palette_indices(&pm, palette), png))
+                draw_progress(pm, k, n);
+                Ok((palette_indices(pm, palette), png))
             })
             .collect::<Result<_>>()?;
         let (w, h) = (size.0 as usize, size.1 as usize);
