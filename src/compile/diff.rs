@@ -58,7 +58,9 @@ struct Adjoints<'a> {
 impl Adjoints<'_> {
     /// adj[child] += contribution.
     fn acc(&mut self, child: NodeId, contrib: NodeId) {
-        if !self.dep[child.index()] {
+        // A constant zero contribution adds nothing (and would leave `a + 0` or a zero
+        // adjoint scaling the child's partials: issue 18's `0 · x`).
+        if !self.dep[child.index()] || self.g.const_value(contrib) == Some(0.0) {
             return;
         }
         let new = match self.adj[child.index()] {
@@ -106,6 +108,9 @@ fn sweep(g: &mut ExprGraph, output: NodeId, n_vars: usize) -> Vec<NodeId> {
                     // d(x/y) = a/y·dx − (a/y)·(x/y)·dy
                     let r = recip(s.g, y);
                     let r = scale(s.g, a, r);
+                    if s.g.const_value(r) == Some(0.0) {
+                        continue;
+                    }
                     s.acc(x, r);
                     if dep[y.index()] {
                         let c = s.g.add(Node::Mul(r, id));
@@ -116,6 +121,9 @@ fn sweep(g: &mut ExprGraph, output: NodeId, n_vars: usize) -> Vec<NodeId> {
                 Node::Atan2(y, x) => {
                     let w = atan2_weight(s.g, y, x);
                     let w = scale(s.g, a, w);
+                    if s.g.const_value(w) == Some(0.0) {
+                        continue;
+                    }
                     if dep[y.index()] {
                         let c = s.g.add(Node::Mul(w, x));
                         s.acc(y, c);

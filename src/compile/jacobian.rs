@@ -98,8 +98,13 @@ pub(crate) fn atan2_weight(g: &mut ExprGraph, y: NodeId, x: NodeId) -> NodeId {
 /// `a · w` where either factor may be an indicator `select(c, 1, 0)` (or
 /// `select(c, 0, 1)`): then the other factor is routed by the select instead of
 /// multiplied, which saves the product and keeps a discarded non-finite factor from
-/// turning `0 · ∞` into NaN.
+/// turning `0 · ∞` into NaN. A constant zero factor gives the constant zero.
 pub(crate) fn scale(g: &mut ExprGraph, a: NodeId, w: NodeId) -> NodeId {
+    // A constant zero factor (an indicator whose condition folded, or a zero adjoint)
+    // contributes nothing: no `0 · x` is built (issue 18), as for a dropped sibling term.
+    if g.const_value(a) == Some(0.0) || g.const_value(w) == Some(0.0) {
+        return g.constant(0.0);
+    }
     for (s, t) in [(a, w), (w, a)] {
         if let Node::Select(c, u, v) = *g.node(s) {
             let (u1, v0) = (g.const_value(u), g.const_value(v));
