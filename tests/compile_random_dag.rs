@@ -1,10 +1,11 @@
 //! Random expression DAGs (proptest): the interpreter equals a direct f64 evaluation of
 //! the same program, the JIT equals the interpreter (both compute the transcendentals with
 //! `foldsynth::trig`; the JIT in batches), and gradients by reverse sweeps and by vertex
-//! elimination equal forward-mode dual numbers.
+//! elimination equal forward-mode dual numbers, also when the JIT fuses the gradients'
+//! sums of products into `fma`.
 
 use foldsynth::compile::vanish::fold_vanishing;
-use foldsynth::compile::{CompiledFn, Dual, Jacobian, jacobian};
+use foldsynth::compile::{CompiledFn, Dual, Jacobian, Options, compile, jacobian};
 use foldsynth::expr::{Ctx, NodeId, Sym, Tape, clamp_unit, select};
 use foldsynth::kinematics::Scalar;
 use proptest::prelude::*;
@@ -232,8 +233,54 @@ proptest! {
     }
 }
 
+/// `compile` with and without fused multiply-add in the gradients (no egg: the program's
+/// own graph).
+fn compile_both(prog: &[Instr]) -> [foldsynth::compile::Compiled; 2] {
+    let (g, ids) = build(prog);
+    [true, false].map(|fma| {
+        let opts = Options {
+            simplify: None,
+            fma,
+            ..Options::default()
+        };
+        compile(&g, &ids, N_VARS, N_PARAMS, &opts).unwrap()
+    })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
+
+    #[test]
+    fn fused_gradients_equal_dual_numbers(prog in program(), (x, p) in inputs()) {
+        // The values are the interpreter's bits with or without fusion; the fused
+        // gradients equal forward-mode dual numbers as the unfused ones do.
+        prop_assume!(all_finite(&prog, &x, &p));
+        let [fused, plain] = compile_both(&prog);
+        let len = fused.layout.len();
+        let (mut rf, mut rp) = (vec![0.0; len], vec![0.0; len]);
+        fused.function.call(&x, &p, &mut rf).unwrap();
+        plain.function.call(&x, &p, &mut rp).unwrap();
+        let dx: Vec<Dual> = (0..N_VARS).map(|i| Dual::var(x[i], i, N_VARS)).collect();
+        let dp: Vec<Dual> = p.iter().map(|&v| Dual::constant(v)).collect();
+        let d = run(&prog, &dx, &dp);
+        let direct = run(&prog, &x, &p);
+        for (k, out) in d.iter().enumerate() {
+            let k_v = fused.layout.value(k);
+            prop_assert!(same(rf[k_v], rp[k_v]), "value {k}: fused {} vs plain {}", rf[k_v], rp[k_v]);
+            prop_assert!(same(rf[k_v], direct[k]), "value {k}: JIT {} vs f64 {}", rf[k_v], direct[k]);
+            if !out.v.is_finite() || out.g.iter().any(|v| !v.is_finite()) {
+                continue;
+            }
+            let want = out.grad(N_VARS);
+            for (i, j) in fused.layout.gradient(k).enumerate() {
+                let scale = rf[j].abs().max(want[i].abs()).max(1.0);
+                prop_assert!(
+                    (rf[j] - want[i]).abs() <= 1e-10 * scale,
+                    "d out{k} / d x{i}: fused {} vs dual {}", rf[j], want[i]
+                );
+            }
+        }
+    }
 
     #[test]
     fn removing_vanishing_terms_keeps_every_value(
@@ -284,6 +331,62 @@ fn vanishing_terms_are_removed_in_random_programs() {
         removed += fold_vanishing(&g, &ids).2;
     }
     assert!(removed > 0);
+}
+
+#[test]
+fn fusion_saves_instructions_where_the_cpu_has_fma() {
+    // f = Σ xᵢ·xⱼ·sin(xₖ): its gradient is sums of products. A value of
+    // f(0.3, -1.2, 2.0) and ∂f/∂x₀ against the closed form in f64.
+    let ctx = Ctx::new();
+    let x: Vec<Sym> = (0..N_VARS).map(|i| ctx.var(i)).collect();
+    let mut f = Sym::from_f64(0.0);
+    for i in 0..N_VARS {
+        for j in 0..N_VARS {
+            let k = (i + j) % N_VARS;
+            f = f + x[i].clone() * x[j].clone() * x[k].sin();
+        }
+    }
+    let ids = [ctx.node_id(&f)];
+    let g = ctx.to_graph();
+    let [fused, plain] = [true, false].map(|fma| {
+        let opts = Options {
+            fma,
+            ..Options::default()
+        };
+        compile(&g, &ids, N_VARS, N_PARAMS, &opts).unwrap()
+    });
+    let v = [0.3, -1.2, 2.0];
+    let (mut rf, mut rp) = ([0.0; 4], [0.0; 4]);
+    fused.function.call(&v, &[0.0; N_PARAMS], &mut rf).unwrap();
+    plain.function.call(&v, &[0.0; N_PARAMS], &mut rp).unwrap();
+    assert_eq!(rf[0].to_bits(), rp[0].to_bits(), "values are not fused");
+    let (s, c) = (|i: usize| v[i].sin(), |i: usize| v[i].cos());
+    // ∂/∂x₀ of Σᵢⱼ xᵢ xⱼ sin(x₍ᵢ₊ⱼ₎ mod 3).
+    let mut want = 0.0;
+    for i in 0..N_VARS {
+        for j in 0..N_VARS {
+            let k = (i + j) % N_VARS;
+            let xi = if i == 0 { 1.0 } else { 0.0 };
+            let xj = if j == 0 { 1.0 } else { 0.0 };
+            let xk = if k == 0 { 1.0 } else { 0.0 };
+            want += (xi * v[j] + v[i] * xj) * s(k) + v[i] * v[j] * xk * c(k);
+        }
+    }
+    for r in [rf, rp] {
+        assert!(
+            (r[1] - want).abs() <= 1e-13 * want.abs().max(1.0),
+            "{} vs {want}",
+            r[1]
+        );
+    }
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("fma") {
+        let (nf, np) = (
+            fused.function.n_instructions(),
+            plain.function.n_instructions(),
+        );
+        assert!(nf < np, "fused {nf} vs plain {np} instructions");
+    }
 }
 
 #[test]

@@ -41,12 +41,21 @@ fn gif_has_the_picked_frames_and_they_move() {
     let scene = Scene::new(&p, &meta, Camera::default()).unwrap();
     let bytes = scene.gif((120, 90), 4, 12).unwrap();
     let mut opts = gif::DecodeOptions::new();
-    opts.set_color_output(gif::ColorOutput::RGBA);
+    opts.set_color_output(gif::ColorOutput::Indexed);
     let mut dec = opts.read_info(bytes.as_slice()).unwrap();
     assert_eq!((dec.width(), dec.height()), (120, 90));
+    // Frames after the first hold only what changed (transparent elsewhere): compose them
+    // over the canvas as a viewer does.
+    let mut canvas = vec![0u8; 120 * 90];
     let mut frames = Vec::new();
     while let Some(f) = dec.read_next_frame().unwrap() {
-        frames.push((f.delay, f.buffer.to_vec()));
+        let fw = usize::from(f.width);
+        for (i, &px) in f.buffer.iter().enumerate() {
+            if Some(px) != f.transparent {
+                canvas[(usize::from(f.top) + i / fw) * 120 + usize::from(f.left) + i % fw] = px;
+            }
+        }
+        frames.push((f.delay, canvas.clone()));
     }
     assert_eq!(frames.len(), 12);
     // The sheet moves: first and last pictures differ; the last frame lingers.

@@ -239,6 +239,8 @@ pub fn object(
         outputs,
         &mark,
         Math::Inline,
+        // Baseline features have no FMA; the library rounds as the interpreter does.
+        usize::MAX,
     )?;
     for k in iface.all_constants(layout) {
         define_size_fn(&mut module, &format!("{name}_{}", k.name), k.value)?;

@@ -258,6 +258,13 @@ enum Source {
 
 /// Define `name` in `module`: the function computing `outputs` of `graph` (`mark`: the
 /// nodes they reach, from [`crate::expr::check_indices`]) with transcendentals by `mode`.
+///
+/// Where the ISA has fused multiply-add, a sum or difference at node index `fuse_from` or
+/// above whose operand is a product used nowhere else becomes one `fma` (one rounding
+/// instead of two, and one instruction: the gradients [`super::compile`] appends are
+/// mostly sums of products). Nodes below `fuse_from` round as the interpreter does, bit
+/// for bit; `usize::MAX` fuses nothing.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn define_eval<M: Module>(
     module: &mut M,
     name: &str,
@@ -266,6 +273,7 @@ pub(crate) fn define_eval<M: Module>(
     outputs: &[NodeId],
     mark: &[bool],
     mode: Math,
+    fuse_from: usize,
 ) -> Result<Built, CompileError> {
     let ptr = module.target_config().pointer_type();
     let mut sig = module.make_signature();
@@ -316,6 +324,13 @@ pub(crate) fn define_eval<M: Module>(
         }
     }
     let slot_len: u32 = batches.iter().map(|b| b.len() as u32).sum();
+    let fused = fusable_products(
+        graph,
+        outputs,
+        mark,
+        fuse_from,
+        module.isa().has_native_fma(),
+    );
 
     let mut ctx: Context = module.make_context();
     ctx.func.signature = sig;
@@ -385,60 +400,88 @@ pub(crate) fn define_eval<M: Module>(
         };
         for (d, phase) in order.iter().enumerate() {
             for &i in phase {
+                if fused[i] {
+                    // Emitted inside its one user's fma.
+                    continue;
+                }
                 let node = nodes[i];
                 let mut o = [None; 3];
+                // (operand position, factors) of a product fused into this sum.
+                let mut fma: Option<(usize, Value, Value)> = None;
                 for (k, c) in node.children().into_iter().enumerate() {
                     // Inline sin/cos whose argument was already done needs no operand.
                     if matches!(node, Node::Sin(_) | Node::Cos(_)) && sincos_done.contains_key(&c) {
                         continue;
                     }
+                    if fused[c.index()]
+                        && let Node::Mul(p, q) = nodes[c.index()]
+                    {
+                        let (p, q) = (operand(&mut b, &src, p), operand(&mut b, &src, q));
+                        fma = Some((k, p, q));
+                        continue;
+                    }
                     o[k] = Some(operand(&mut b, &src, c));
                 }
                 let v = |k: usize| o[k].expect("operand emitted");
-                let x = match node {
-                    Node::Const(_) => unreachable!("constants are emitted at their uses"),
-                    Node::Var(k) => b.ins().load(types::F64, mem, vars_p, 8 * k as i32),
-                    Node::Param(k) => b.ins().load(types::F64, mem, params_p, 8 * k as i32),
-                    Node::Add(..) => b.ins().fadd(v(0), v(1)),
-                    Node::Sub(..) => b.ins().fsub(v(0), v(1)),
-                    Node::Mul(..) => b.ins().fmul(v(0), v(1)),
-                    Node::Div(..) => b.ins().fdiv(v(0), v(1)),
-                    Node::Neg(_) => b.ins().fneg(v(0)),
-                    Node::Sqrt(_) => b.ins().sqrt(v(0)),
-                    Node::Sin(a) | Node::Cos(a) => {
-                        let (sv, cv) = match sincos_done.get(&a) {
-                            Some(&r) => r,
-                            None => {
-                                let fns = *libm_fns.get_or_insert_with(|| {
-                                    let [s, c] = import_libm(module, b.func);
-                                    (s, c)
-                                });
-                                let r = inline_sin_cos(&mut b, v(0), fns);
-                                n_calls += 2;
-                                sincos_done.insert(a, r);
-                                r
-                            }
-                        };
-                        if matches!(node, Node::Sin(_)) { sv } else { cv }
+                let x = match (node, fma) {
+                    // a·b + c, c + a·b
+                    (Node::Add(..), Some((k, p, q))) => b.ins().fma(p, q, v(1 - k)),
+                    // a·b − c
+                    (Node::Sub(..), Some((0, p, q))) => {
+                        let c = b.ins().fneg(v(1));
+                        b.ins().fma(p, q, c)
                     }
-                    Node::Acos(_) => trig::emit_acos(&mut Ir { b: &mut b }, v(0)),
-                    Node::Atan2(..) => trig::emit_atan2(&mut Ir { b: &mut b }, v(0), v(1)),
-                    Node::Sgn(_) => {
-                        let a = v(0);
-                        let zero = b.ins().f64const(0.0);
-                        let one = b.ins().f64const(1.0);
-                        let mone = b.ins().f64const(-1.0);
-                        let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
-                        let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
-                        let neg_or_zero = b.ins().select(lt, mone, zero);
-                        b.ins().select(gt, one, neg_or_zero)
+                    // c − a·b
+                    (Node::Sub(..), Some((_, p, q))) => {
+                        let p = b.ins().fneg(p);
+                        b.ins().fma(p, q, v(0))
                     }
-                    Node::Clamp(_) => clamp_unit(&mut b, v(0)),
-                    Node::Select(..) => {
-                        let zero = b.ins().f64const(0.0);
-                        let gt = b.ins().fcmp(FloatCC::GreaterThan, v(0), zero);
-                        b.ins().select(gt, v(1), v(2))
-                    }
+                    (_, Some(_)) => unreachable!("only sums and differences fuse"),
+                    (node, None) => match node {
+                        Node::Const(_) => unreachable!("constants are emitted at their uses"),
+                        Node::Var(k) => b.ins().load(types::F64, mem, vars_p, 8 * k as i32),
+                        Node::Param(k) => b.ins().load(types::F64, mem, params_p, 8 * k as i32),
+                        Node::Add(..) => b.ins().fadd(v(0), v(1)),
+                        Node::Sub(..) => b.ins().fsub(v(0), v(1)),
+                        Node::Mul(..) => b.ins().fmul(v(0), v(1)),
+                        Node::Div(..) => b.ins().fdiv(v(0), v(1)),
+                        Node::Neg(_) => b.ins().fneg(v(0)),
+                        Node::Sqrt(_) => b.ins().sqrt(v(0)),
+                        Node::Sin(a) | Node::Cos(a) => {
+                            let (sv, cv) = match sincos_done.get(&a) {
+                                Some(&r) => r,
+                                None => {
+                                    let fns = *libm_fns.get_or_insert_with(|| {
+                                        let [s, c] = import_libm(module, b.func);
+                                        (s, c)
+                                    });
+                                    let r = inline_sin_cos(&mut b, v(0), fns);
+                                    n_calls += 2;
+                                    sincos_done.insert(a, r);
+                                    r
+                                }
+                            };
+                            if matches!(node, Node::Sin(_)) { sv } else { cv }
+                        }
+                        Node::Acos(_) => trig::emit_acos(&mut Ir { b: &mut b }, v(0)),
+                        Node::Atan2(..) => trig::emit_atan2(&mut Ir { b: &mut b }, v(0), v(1)),
+                        Node::Sgn(_) => {
+                            let a = v(0);
+                            let zero = b.ins().f64const(0.0);
+                            let one = b.ins().f64const(1.0);
+                            let mone = b.ins().f64const(-1.0);
+                            let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
+                            let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
+                            let neg_or_zero = b.ins().select(lt, mone, zero);
+                            b.ins().select(gt, one, neg_or_zero)
+                        }
+                        Node::Clamp(_) => clamp_unit(&mut b, v(0)),
+                        Node::Select(..) => {
+                            let zero = b.ins().f64const(0.0);
+                            let gt = b.ins().fcmp(FloatCC::GreaterThan, v(0), zero);
+                            b.ins().select(gt, v(1), v(2))
+                        }
+                    },
                 };
                 n_inst += 1;
                 src[i] = Source::Value(x);
@@ -504,6 +547,46 @@ pub(crate) fn define_eval<M: Module>(
         n_instructions: n_inst,
         n_calls,
     })
+}
+
+/// Which products [`define_eval`] fuses into their user (`fma` on): a `Mul` used exactly
+/// once among the marked nodes and not an output, whose user is an `Add` or `Sub` at
+/// index `fuse_from` or above (one product per user).
+fn fusable_products(
+    graph: &ExprGraph,
+    outputs: &[NodeId],
+    mark: &[bool],
+    fuse_from: usize,
+    fma: bool,
+) -> Vec<bool> {
+    let nodes = graph.nodes();
+    let mut fused = vec![false; nodes.len()];
+    if !fma || fuse_from >= nodes.len() {
+        return fused;
+    }
+    let mut uses = vec![0u32; nodes.len()];
+    for (i, n) in nodes.iter().enumerate() {
+        if mark[i] {
+            for c in n.children() {
+                uses[c.index()] += 1;
+            }
+        }
+    }
+    for o in outputs {
+        uses[o.index()] += 1;
+    }
+    for (i, n) in nodes.iter().enumerate().skip(fuse_from) {
+        if mark[i]
+            && matches!(n, Node::Add(..) | Node::Sub(..))
+            && let Some(c) = n
+                .children()
+                .into_iter()
+                .find(|c| uses[c.index()] == 1 && matches!(nodes[c.index()], Node::Mul(..)))
+        {
+            fused[c.index()] = true;
+        }
+    }
+    fused
 }
 
 /// Import `void foldsynth_trig_batch(double *, size_t, size_t, size_t)`.

@@ -3,7 +3,9 @@
 //! The adjoint of every node is accumulated in reverse topological order (decreasing node
 //! id) as new nodes of the same graph, so the gradient shares every forward node (the
 //! value+gradient cost is a small multiple of the value's). Only nodes that depend on a
-//! variable get adjoints.
+//! variable get adjoints. The local partials are [`super::jacobian`]'s (independent of
+//! the adjoint, so the sweep and the vertex elimination share them, and every quotient by
+//! `y` in them is a product with the one reciprocal `1/y`).
 //!
 //! Derivatives never produce NaN or infinities where the function is finite:
 //! - `sgn`: 0;
@@ -11,8 +13,8 @@
 //!   only where `p > 0` (that is `|x| < 1`), 0 elsewhere. `sqrt(p)` is the very node the
 //!   simplifier makes of `sin(acos x)`, so the two share;
 //! - `clamp(x)`: 1 where `(1 - x)(1 + x) > 0`, else 0;
-//! - `sqrt(x) = s`: `0.5/s` where `s > 0`, else 0;
-//! - `atan2(y, x)`: `(x, -y)/r`, `r = x² + y²`, where `r > 0`, else 0;
+//! - `sqrt(x) = s`: `0.5·(1/s)` where `s > 0`, else 0;
+//! - `atan2(y, x)`: `(x, -y)·(1/r)`, `r = x² + y²`, where `r > 0`, else 0;
 //! - `select(c, a, b)`: routes the adjoint to the selected branch (c is not differentiated).
 //!
 //! The guards are [`Node::Select`] nodes: both branches are evaluated and the discarded
@@ -23,6 +25,7 @@
 //! NaN although the value is finite (forward mode would not). The kinematics never
 //! discards a non-finite branch (its only forward selects are `max(0, x)`).
 
+use super::jacobian::{atan2_weight, partials, recip, scale};
 use crate::expr::{ExprGraph, Node, NodeId, ShapeError, check_indices};
 
 /// The gradient of `output` with respect to variables `0..n_vars`, as nodes of `graph`.
@@ -53,26 +56,16 @@ struct Adjoints<'a> {
 }
 
 impl Adjoints<'_> {
-    /// adj[child] += contribution (or -= with `neg`).
-    fn acc(&mut self, child: NodeId, contrib: NodeId, neg: bool) {
+    /// adj[child] += contribution.
+    fn acc(&mut self, child: NodeId, contrib: NodeId) {
         if !self.dep[child.index()] {
             return;
         }
-        let new = match (self.adj[child.index()], neg) {
-            (None, false) => contrib,
-            (None, true) => self.g.add(Node::Neg(contrib)),
-            (Some(e), false) => self.g.add(Node::Add(e, contrib)),
-            (Some(e), true) => self.g.add(Node::Sub(e, contrib)),
+        let new = match self.adj[child.index()] {
+            None => contrib,
+            Some(e) => self.g.add(Node::Add(e, contrib)),
         };
         self.adj[child.index()] = Some(new);
-    }
-
-    fn op(&mut self, node: Node) -> NodeId {
-        self.g.add(node)
-    }
-
-    fn constant(&mut self, c: f64) -> NodeId {
-        self.g.constant(c)
     }
 }
 
@@ -103,98 +96,43 @@ fn sweep(g: &mut ExprGraph, output: NodeId, n_vars: usize) -> Vec<NodeId> {
             }
             let Some(a) = s.adj[i] else { continue };
             let id = NodeId(i as u32);
+            if let Node::Var(k) = *s.g.node(id) {
+                grad[k as usize] = Some(a);
+                continue;
+            }
             match *s.g.node(id) {
-                Node::Var(k) => grad[k as usize] = Some(a),
-                Node::Const(_) | Node::Param(_) => {}
-                Node::Add(x, y) => {
-                    s.acc(x, a, false);
-                    s.acc(y, a, false);
-                }
-                Node::Sub(x, y) => {
-                    s.acc(x, a, false);
-                    s.acc(y, a, true);
-                }
-                Node::Mul(x, y) => {
-                    if dep[x.index()] {
-                        let c = s.op(Node::Mul(a, y));
-                        s.acc(x, c, false);
-                    }
-                    if dep[y.index()] {
-                        let c = s.op(Node::Mul(a, x));
-                        s.acc(y, c, false);
-                    }
-                }
+                // Two partials with a common factor: scale it by the adjoint once.
                 Node::Div(x, y) => {
-                    // d(x/y) = dx/y - (x/y) dy/y: share r = a/y.
-                    let r = s.op(Node::Div(a, y));
-                    s.acc(x, r, false);
+                    // d(x/y) = a/y·dx − (a/y)·(x/y)·dy
+                    let r = recip(s.g, y);
+                    let r = scale(s.g, a, r);
+                    s.acc(x, r);
                     if dep[y.index()] {
-                        let c = s.op(Node::Mul(r, id));
-                        s.acc(y, c, true);
+                        let c = s.g.add(Node::Mul(r, id));
+                        let c = s.g.add(Node::Neg(c));
+                        s.acc(y, c);
                     }
-                }
-                Node::Neg(x) => s.acc(x, a, true),
-                Node::Sin(x) => {
-                    let c = s.op(Node::Cos(x));
-                    let c = s.op(Node::Mul(a, c));
-                    s.acc(x, c, false);
-                }
-                Node::Cos(x) => {
-                    let sn = s.op(Node::Sin(x));
-                    let c = s.op(Node::Mul(a, sn));
-                    s.acc(x, c, true);
-                }
-                Node::Acos(x) => {
-                    let p = one_minus_sq(&mut s, x);
-                    let r = s.op(Node::Sqrt(p));
-                    let q = s.op(Node::Div(a, r));
-                    let zero = s.constant(0.0);
-                    let c = s.op(Node::Select(p, q, zero));
-                    s.acc(x, c, true);
-                }
-                Node::Sqrt(x) => {
-                    let half = s.constant(0.5);
-                    let h = s.op(Node::Mul(half, a));
-                    let q = s.op(Node::Div(h, id));
-                    let zero = s.constant(0.0);
-                    let c = s.op(Node::Select(id, q, zero));
-                    s.acc(x, c, false);
                 }
                 Node::Atan2(y, x) => {
-                    let xx = s.op(Node::Mul(x, x));
-                    let yy = s.op(Node::Mul(y, y));
-                    let r = s.op(Node::Add(xx, yy));
-                    let q = s.op(Node::Div(a, r));
-                    let zero = s.constant(0.0);
-                    let w = s.op(Node::Select(r, q, zero));
+                    let w = atan2_weight(s.g, y, x);
+                    let w = scale(s.g, a, w);
                     if dep[y.index()] {
-                        let c = s.op(Node::Mul(w, x));
-                        s.acc(y, c, false);
+                        let c = s.g.add(Node::Mul(w, x));
+                        s.acc(y, c);
                     }
                     if dep[x.index()] {
-                        let c = s.op(Node::Mul(w, y));
-                        s.acc(x, c, true);
+                        let c = s.g.add(Node::Mul(w, y));
+                        let c = s.g.add(Node::Neg(c));
+                        s.acc(x, c);
                     }
                 }
-                Node::Sgn(_) => {}
-                Node::Clamp(x) => {
-                    let one = s.constant(1.0);
-                    let omx = s.op(Node::Sub(one, x));
-                    let opx = s.op(Node::Add(one, x));
-                    let p = s.op(Node::Mul(omx, opx));
-                    let zero = s.constant(0.0);
-                    let c = s.op(Node::Select(p, a, zero));
-                    s.acc(x, c, false);
-                }
-                Node::Select(c, u, v) => {
-                    let zero = s.constant(0.0);
-                    if dep[u.index()] {
-                        let d = s.op(Node::Select(c, a, zero));
-                        s.acc(u, d, false);
-                    }
-                    if dep[v.index()] {
-                        let d = s.op(Node::Select(c, zero, a));
-                        s.acc(v, d, false);
+                // adj[child] += adj[node] · ∂node/∂child, with the elimination's partials
+                // (so both share them and their reciprocals) and ±1 and indicator factors
+                // folded.
+                _ => {
+                    for (c, w) in partials(s.g, id, &dep) {
+                        let contrib = scale(s.g, a, w);
+                        s.acc(NodeId(c as u32), contrib);
                     }
                 }
             }
@@ -212,10 +150,6 @@ pub(crate) fn one_minus_sq_node(g: &mut ExprGraph, x: NodeId) -> NodeId {
     let a = g.add(Node::Sub(one, c));
     let b = g.add(Node::Add(one, c));
     g.add(Node::Mul(a, b))
-}
-
-fn one_minus_sq(s: &mut Adjoints<'_>, x: NodeId) -> NodeId {
-    one_minus_sq_node(s.g, x)
 }
 
 #[cfg(test)]

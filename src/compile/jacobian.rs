@@ -11,13 +11,14 @@
 //! vertex with the fewest `preds × succs` products first.
 //!
 //! Measured on the gripper task's 159 design models (objective first, then the
-//! constraints): reverse sweeps for the objective and elimination for the constraints
-//! ([`Jacobian::Auto`]) compile 37% fewer operations than reverse sweeps for all, and the
-//! compiled code runs and compiles about a quarter faster; on the robotic arm's (whose
-//! objective dominates) 7% fewer.
+//! constraints): a reverse sweep for the objective and elimination for the constraints
+//! compile 37% fewer operations than reverse sweeps for all, and the compiled code runs
+//! and compiles about a quarter faster; on the robotic arm's (whose objective dominates)
+//! 7% fewer. Elimination for the objective too is smaller again on some models and much
+//! larger on others, so [`Jacobian::Auto`] builds both and keeps the smaller.
 //!
-//! The local partials and their guards are exactly [`super::diff`]'s, so both have the
-//! same NaN behaviour (see its docs).
+//! The local partials and their guards are the reverse sweep's too (one function is
+//! shared), so both have the same NaN behaviour (see [`super::diff`]'s docs).
 
 use super::diff::{gradients, one_minus_sq_node};
 use crate::expr::{ExprGraph, Node, NodeId, ShapeError, check_indices};
@@ -31,8 +32,12 @@ pub enum Jacobian {
     Reverse,
     /// Vertex elimination in Markowitz order for all outputs.
     Eliminate,
-    /// A reverse sweep for the first output, vertex elimination for the others (a
-    /// model's objective comes first, its constraints after it).
+    /// A reverse sweep for the first output and vertex elimination for the others (a
+    /// model's objective comes first, its constraints after it), or elimination for all
+    /// outputs, whichever has fewer operations (both are built). Measured on 2 Dec:
+    /// elimination for all wins on the gripper's model `2, 3, (4, 8), 4, (7, 8)` (1,474
+    /// operations against 1,600; value + gradients 590 against 613 ns) and loses on the
+    /// robotic arm's `2, 4, 6, (3, 9), (6, 10)` (14,322 against 12,136; 6.4 against 4.6 µs).
     #[default]
     Auto,
 }
@@ -50,17 +55,70 @@ pub fn jacobian(
         Jacobian::Reverse => gradients(graph, outputs, n_vars)?,
         Jacobian::Eliminate => eliminate(graph, outputs, n_vars),
         Jacobian::Auto => {
+            // Elimination for all outputs as well, on a copy; the fewer operations win.
+            let mut all = graph.clone();
+            let elim = eliminate(&mut all, outputs, n_vars);
             let k = outputs.len().min(1);
             let mut rows = gradients(graph, &outputs[..k], n_vars)?;
             rows.extend(eliminate(graph, &outputs[k..], n_vars));
-            rows
+            let ops = |g: &ExprGraph, rows: &[Vec<NodeId>]| {
+                let ids: Vec<NodeId> = rows.iter().flatten().copied().collect();
+                g.counts(&ids).ops
+            };
+            if ops(&all, &elim) < ops(graph, &rows) {
+                *graph = all;
+                elim
+            } else {
+                rows
+            }
         }
     })
 }
 
+/// `1/y`: the one division by `y` that every partial dividing by `y` shares (hash-consed
+/// across the reverse sweep and the elimination). Divisions are the slowest arithmetic in
+/// the generated code (on the gripper's design model the gradients had 59 divisions by
+/// 30 distinct denominators); a reciprocal and a product round twice, within 1 ulp of the
+/// quotient.
+pub(crate) fn recip(g: &mut ExprGraph, y: NodeId) -> NodeId {
+    let one = g.constant(1.0);
+    g.add(Node::Div(one, y))
+}
+
+/// `1/r` where `r = x² + y² > 0`, else 0: `atan2(y, x)`'s partials are `(x, −y)` times it.
+pub(crate) fn atan2_weight(g: &mut ExprGraph, y: NodeId, x: NodeId) -> NodeId {
+    let xx = g.add(Node::Mul(x, x));
+    let yy = g.add(Node::Mul(y, y));
+    let r = g.add(Node::Add(xx, yy));
+    let q = recip(g, r);
+    let zero = g.constant(0.0);
+    g.add(Node::Select(r, q, zero))
+}
+
+/// `a · w` where either factor may be an indicator `select(c, 1, 0)` (or
+/// `select(c, 0, 1)`): then the other factor is routed by the select instead of
+/// multiplied, which saves the product and keeps a discarded non-finite factor from
+/// turning `0 · ∞` into NaN.
+pub(crate) fn scale(g: &mut ExprGraph, a: NodeId, w: NodeId) -> NodeId {
+    for (s, t) in [(a, w), (w, a)] {
+        if let Node::Select(c, u, v) = *g.node(s) {
+            let (u1, v0) = (g.const_value(u), g.const_value(v));
+            if u1 == Some(1.0) && v0 == Some(0.0) {
+                return g.add(Node::Select(c, t, v));
+            }
+            if u1 == Some(0.0) && v0 == Some(1.0) {
+                return g.add(Node::Select(c, u, t));
+            }
+        }
+    }
+    g.add(Node::Mul(a, w))
+}
+
 /// The local partials `(child, ∂node/∂child)` of node `id` for the children that depend
-/// on a variable (a child appearing twice gets the sum).
-fn partials(g: &mut ExprGraph, id: NodeId, dep: &[bool]) -> Vec<(usize, NodeId)> {
+/// on a variable (a child appearing twice gets the sum). They do not depend on the
+/// adjoint, so the reverse sweep of [`super::diff`] (which multiplies them by it) and
+/// the elimination share them.
+pub(crate) fn partials(g: &mut ExprGraph, id: NodeId, dep: &[bool]) -> Vec<(usize, NodeId)> {
     let node = *g.node(id);
     let one = g.constant(1.0);
     let mone = g.constant(-1.0);
@@ -74,9 +132,10 @@ fn partials(g: &mut ExprGraph, id: NodeId, dep: &[bool]) -> Vec<(usize, NodeId)>
         Node::Mul(x, y) => out.extend([(x, y), (y, x)]),
         Node::Div(x, y) => {
             // d(x/y) = dx/y − (x/y)·dy/y
-            out.push((x, g.add(Node::Div(one, y))));
+            let r = recip(g, y);
+            out.push((x, r));
             if dep[y.index()] {
-                let q = g.add(Node::Div(id, y));
+                let q = g.add(Node::Mul(id, r));
                 out.push((y, g.add(Node::Neg(q))));
             }
         }
@@ -89,21 +148,19 @@ fn partials(g: &mut ExprGraph, id: NodeId, dep: &[bool]) -> Vec<(usize, NodeId)>
             // −1/√p where p = (1 − c)(1 + c) > 0, else 0.
             let p = one_minus_sq_node(g, x);
             let r = g.add(Node::Sqrt(p));
-            let q = g.add(Node::Div(mone, r));
+            let r = recip(g, r);
+            let q = g.add(Node::Neg(r));
             out.push((x, g.add(Node::Select(p, q, zero))));
         }
         Node::Sqrt(x) => {
+            // 0.5/√x where √x > 0, else 0.
             let half = g.constant(0.5);
-            let q = g.add(Node::Div(half, id));
+            let r = recip(g, id);
+            let q = g.add(Node::Mul(half, r));
             out.push((x, g.add(Node::Select(id, q, zero))));
         }
         Node::Atan2(y, x) => {
-            // (x, −y)/r, r = x² + y², where r > 0, else 0.
-            let xx = g.add(Node::Mul(x, x));
-            let yy = g.add(Node::Mul(y, y));
-            let r = g.add(Node::Add(xx, yy));
-            let q = g.add(Node::Div(one, r));
-            let w = g.add(Node::Select(r, q, zero));
+            let w = atan2_weight(g, y, x);
             if dep[y.index()] {
                 out.push((y, g.add(Node::Mul(w, x))));
             }
@@ -225,7 +282,7 @@ fn eliminate(g: &mut ExprGraph, outputs: &[NodeId], n_vars: usize) -> Vec<Vec<No
         for &s in &ss {
             let w_vs = lin.preds[s].remove(&v).expect("edge v → s");
             for &(p, w_pv) in &ps {
-                let m = g.add(Node::Mul(w_pv, w_vs));
+                let m = scale(g, w_pv, w_vs);
                 let w = match lin.preds[s].get(&p) {
                     Some(&e) => g.add(Node::Add(e, m)),
                     None => m,

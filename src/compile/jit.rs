@@ -3,7 +3,8 @@
 //!
 //! The function body comes from [`super::codegen`], the builder the ahead-of-time object
 //! ([`super::aot`]) uses too. Its transcendentals are [`crate::trig`]'s kernels, the
-//! interpreter's very functions, so results agree bit for bit: the batch symbol is bound to
+//! interpreter's very functions, so results agree bit for bit (except sums of products
+//! fused on request, [`CompiledFn::with_fma_from`]): the batch symbol is bound to
 //! [`crate::trig::trig_batch`], and `sin`/`cos` (the inline code's cold path) to Rust's
 //! `f64` methods, which [`crate::trig`] uses there too.
 
@@ -95,6 +96,21 @@ impl CompiledFn {
         opt: OptLevel,
         math: Math,
     ) -> Result<CompiledFn, CompileError> {
+        Self::with_fma_from(graph, outputs, n_vars, n_params, opt, math, usize::MAX)
+    }
+
+    /// [`CompiledFn::with_options`] where, if this CPU has fused multiply-add, the sums
+    /// of products at node index `fma_from` and above may round once (see
+    /// [`super::Options::fma`]); the nodes below agree with the interpreter bit for bit.
+    pub fn with_fma_from(
+        graph: &ExprGraph,
+        outputs: &[NodeId],
+        n_vars: usize,
+        n_params: usize,
+        opt: OptLevel,
+        math: Math,
+        fma_from: usize,
+    ) -> Result<CompiledFn, CompileError> {
         let mark = check_indices(graph, outputs, n_vars, n_params)?;
         let n_nodes = mark.iter().filter(|m| **m).count();
         let isa = codegen::isa(Target::Jit, opt, n_nodes)?;
@@ -112,6 +128,7 @@ impl CompiledFn {
             outputs,
             &mark,
             math,
+            fma_from,
         );
         match result {
             Ok(built) => {

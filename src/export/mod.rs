@@ -496,15 +496,31 @@ pub fn write_all(
 
     let scene = render::Scene::new(pattern, meta, opts.camera)?;
     let picked = picked_frames(pattern.frames.len(), opts.picture_states);
-    for ((k, png), fsvg) in picked.iter().zip(&files.pngs).zip(&files.folded_svgs) {
-        write_file(png, scene.png(Some(*k), opts.image_size)?)?;
+    // With the GIF, the pictures' states are drawn once, for both (the GIF shows them all
+    // unless gif_max_frames picks fewer; the others are drawn on their own).
+    let pngs = match &files.gif {
+        Some(gif) => {
+            let (bytes, pngs) = scene.gif_and_pngs(
+                opts.image_size,
+                opts.gif_delay_cs,
+                opts.gif_max_frames,
+                &picked,
+            )?;
+            write_file(gif, bytes)?;
+            pngs
+        }
+        None => picked
+            .iter()
+            .map(|&k| scene.png(Some(k), opts.image_size))
+            .collect::<Result<_>>()?,
+    };
+    for ((k, png), (path, fsvg)) in picked
+        .iter()
+        .zip(pngs)
+        .zip(files.pngs.iter().zip(&files.folded_svgs))
+    {
+        write_file(path, png)?;
         write_file(fsvg, scene.svg(Some(*k), opts.image_size))?;
-    }
-    if let Some(gif) = &files.gif {
-        write_file(
-            gif,
-            scene.gif(opts.image_size, opts.gif_delay_cs, opts.gif_max_frames)?,
-        )?;
     }
     Ok(files)
 }

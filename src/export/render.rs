@@ -90,6 +90,9 @@ pub struct GifPalette {
     /// `[r, g, b]` per entry, 256 entries.
     pub rgb: Vec<u8>,
     lut: Vec<u8>,
+    /// An entry the table never returns (the colour cube's black and white duplicate the
+    /// greys', and the first of equals wins), so a GIF frame can use it as "transparent".
+    transparent: Option<u8>,
 }
 
 impl GifPalette {
@@ -97,6 +100,12 @@ impl GifPalette {
     #[inline]
     pub fn index(&self, r: u8, g: u8, b: u8) -> u8 {
         self.lut[(usize::from(r >> 3) << 10) | (usize::from(g >> 3) << 5) | usize::from(b >> 3)]
+    }
+
+    /// The entry no colour maps to, used as the transparent index of the GIF's delta frames
+    /// (`None` if every entry is used; then every frame is written whole).
+    pub fn transparent(&self) -> Option<u8> {
+        self.transparent
     }
 
     /// The colour of entry `i`.
@@ -146,9 +155,15 @@ impl GifPalette {
             let d = |p: &[u8; 3]| (0..3).map(|i| (p[i] as i32 - c[i]).pow(2)).sum::<i32>();
             *entry = (0..cols.len()).min_by_key(|&i| d(&cols[i])).unwrap_or(0) as u8;
         }
+        let mut used = [false; 256];
+        for &i in &lut {
+            used[usize::from(i)] = true;
+        }
+        let transparent = (0..=255u8).rev().find(|&i| !used[usize::from(i)]);
         GifPalette {
             rgb: cols.into_iter().flatten().collect(),
             lut,
+            transparent,
         }
     }
 }
@@ -184,7 +199,8 @@ enum Item {
 pub struct Scene<'a> {
     pattern: &'a Pattern,
     meta: &'a DesignMeta,
-    camera: Camera,
+    /// [`Camera::basis`] of the scene's camera, computed once: every projected point needs it.
+    basis: (V3, V3, V3),
     lo: [f64; 2],
     hi: [f64; 2],
 }
@@ -243,7 +259,7 @@ impl<'a> Scene<'a> {
         let mut s = Scene {
             pattern,
             meta,
-            camera,
+            basis: camera.basis(),
             lo: [f64::INFINITY; 2],
             hi: [f64::NEG_INFINITY; 2],
         };
@@ -275,12 +291,12 @@ impl<'a> Scene<'a> {
     }
 
     fn project(&self, p: V3) -> [f64; 2] {
-        let (r, u, _) = self.camera.basis();
+        let (r, u, _) = self.basis;
         [geom::dot(p, r), geom::dot(p, u)]
     }
 
     fn depth(&self, p: V3) -> f64 {
-        geom::dot(p, self.camera.basis().2)
+        geom::dot(p, self.basis.2)
     }
 
     fn coords(&self, frame: Option<usize>) -> Vec<V3> {
@@ -292,7 +308,7 @@ impl<'a> Scene<'a> {
 
     /// The items of one state, back to front.
     fn items(&self, frame: Option<usize>) -> Vec<Item> {
-        let (_, up, dir) = self.camera.basis();
+        let (_, up, dir) = self.basis;
         let light = geom::normalize(geom::add(dir, geom::scale(up, 0.6))).unwrap_or(dir);
         let coords = self.coords(frame);
         let mut polys: Vec<(f64, Item)> = Vec::new();
@@ -405,6 +421,14 @@ impl<'a> Scene<'a> {
         Self::check_size(size)?;
         let mut pm = Pixmap::new(size.0, size.1)
             .ok_or_else(|| ExportError::Image("cannot allocate the image".into()))?;
+        self.draw(&mut pm, frame);
+        Ok(pm)
+    }
+
+    /// Draw one state over the whole of `pm` (cleared to white first), so a caller
+    /// drawing many states can reuse one pixmap.
+    fn draw(&self, pm: &mut Pixmap, frame: Option<usize>) {
+        let size = (pm.width(), pm.height());
         pm.fill(Color::WHITE);
         let fit = self.fit(size);
         let paint_of = |c: Rgba| {
@@ -496,12 +520,11 @@ impl<'a> Scene<'a> {
                 }
             }
         }
-        self.draw_axes(&mut pm, size);
-        Ok(pm)
+        self.draw_axes(pm, size);
     }
 
     fn axes_lines(&self, size: (u32, u32)) -> Vec<([f64; 2], [f64; 2], Rgba, &'static str)> {
-        let (r, u, _) = self.camera.basis();
+        let (r, u, _) = self.basis;
         let origin = [24.0, size.1 as f64 - 24.0];
         let axes = [
             ([1.0, 0.0, 0.0], AXES[0], "x"),
@@ -539,9 +562,7 @@ impl<'a> Scene<'a> {
 
     /// One state as PNG bytes.
     pub fn png(&self, frame: Option<usize>, size: (u32, u32)) -> Result<Vec<u8>> {
-        self.pixmap(frame, size)?
-            .encode_png()
-            .map_err(|e| ExportError::Image(e.to_string()))
+        encode_png(&self.pixmap(frame, size)?)
     }
 
     /// The motion as an animated GIF (looping, with a pause at the end and a progress bar
@@ -549,9 +570,26 @@ impl<'a> Scene<'a> {
     /// pattern's frames (first and last included). `delay_cs` is the frame delay in 1/100 s.
     ///
     /// The colours are the renderer's own ([`gif_palette`]: one global palette, no
-    /// per-frame quantization), and the frames are drawn, mapped and LZW-compressed in
-    /// parallel; only the byte stream is written in order.
+    /// per-frame quantization). After the first frame each frame holds only the rectangle
+    /// that changed, with unchanged pixels in it transparent (disposal "keep"), so a
+    /// viewer composes exactly the full pictures while LZW reads far fewer, far more
+    /// repetitive bytes. Frames are drawn, mapped and compressed in parallel; only the byte
+    /// stream is written in order.
     pub fn gif(&self, size: (u32, u32), delay_cs: u16, max_frames: usize) -> Result<Vec<u8>> {
+        Ok(self.gif_and_pngs(size, delay_cs, max_frames, &[])?.0)
+    }
+
+    /// [`Scene::gif`] and [`Scene::png`] of each state in `pictures` (indices into the
+    /// pattern's frames), drawing a state the animation shows only once: its PNG is the
+    /// animation frame's pixmap before the progress bar is drawn on it. The PNGs come back
+    /// in the order of `pictures`.
+    pub fn gif_and_pngs(
+        &self,
+        size: (u32, u32),
+        delay_cs: u16,
+        max_frames: usize,
+        pictures: &[usize],
+    ) -> Result<(Vec<u8>, Vec<Vec<u8>>)> {
         Self::check_size(size)?;
         let total = self.pattern.frames.len();
         if total == 0 {
@@ -563,43 +601,50 @@ impl<'a> Scene<'a> {
         let picked = super::picked_frames(total, max_frames.max(2));
         let n = picked.len();
         let palette = gif_palette();
-        let frames: Vec<gif::Frame<'static>> = picked
+        let blank = || {
+            Pixmap::new(size.0, size.1)
+                .ok_or_else(|| ExportError::Image("cannot allocate the image".into()))
+        };
+        let drawn: Vec<(Vec<u8>, Option<Vec<u8>>)> = picked
             .par_iter()
             .enumerate()
-            .map(|(k, &frame_index)| -> Result<gif::Frame<'static>> {
-                let mut pm = self.pixmap(Some(frame_index), size)?;
-                let frac = if n > 1 {
-                    k as f32 / (n - 1) as f32
+            // One pixmap per worker, redrawn for each of its frames.
+            .map_init(blank, |pm, (k, &frame_index)| {
+                let pm = pm.as_mut().map_err(|e| ExportError::Image(e.to_string()))?;
+                self.draw(pm, Some(frame_index));
+                let png = if pictures.contains(&frame_index) {
+                    Some(encode_png(pm)?)
                 } else {
-                    1.0
+                    None
                 };
-                if let Some(rect) = tiny_skia::Rect::from_xywh(
-                    0.0,
-                    size.1 as f32 - 4.0,
-                    (size.0 as f32 * frac).max(1.0),
-                    4.0,
-                ) {
-                    let mut p = Paint::default();
-                    p.set_color_rgba8(PROGRESS.0, PROGRESS.1, PROGRESS.2, PROGRESS.3);
-                    pm.fill_rect(rect, &p, Transform::identity(), None);
-                }
-                // Opaque white background: premultiplied RGBA equals straight RGBA here.
-                let indices: Vec<u8> = pm
-                    .data()
-                    .chunks_exact(4)
-                    .map(|px| palette.index(px[0], px[1], px[2]))
-                    .collect();
-                let mut frame =
-                    gif::Frame::from_indexed_pixels(size.0 as u16, size.1 as u16, indices, None);
+                draw_progress(pm, k, n);
+                Ok((palette_indices(pm, palette), png))
+            })
+            .collect::<Result<_>>()?;
+        let (w, h) = (size.0 as usize, size.1 as usize);
+        let frames: Vec<gif::Frame<'static>> = (0..n)
+            .into_par_iter()
+            .map(|k| {
+                let cur = &drawn[k].0;
+                let mut frame = match (k.checked_sub(1), palette.transparent()) {
+                    (Some(prev), Some(t)) => delta_frame(&drawn[prev].0, cur, w, h, t),
+                    _ => gif::Frame::from_indexed_pixels(
+                        size.0 as u16,
+                        size.1 as u16,
+                        cur.clone(),
+                        None,
+                    ),
+                };
+                frame.dispose = gif::DisposalMethod::Keep;
                 frame.delay = if k + 1 == n {
                     delay_cs.saturating_mul(8).max(50)
                 } else {
                     delay_cs
                 };
                 frame.make_lzw_pre_encoded();
-                Ok(frame)
+                frame
             })
-            .collect::<Result<_>>()?;
+            .collect();
         let img = |e: gif::EncodingError| ExportError::Image(e.to_string());
         let mut enc = gif::Encoder::new(Vec::new(), size.0 as u16, size.1 as u16, &palette.rgb)
             .map_err(img)?;
@@ -607,7 +652,18 @@ impl<'a> Scene<'a> {
         for frame in &frames {
             enc.write_lzw_pre_encoded_frame(frame).map_err(img)?;
         }
-        enc.into_inner().map_err(img)
+        let gif = enc.into_inner().map_err(img)?;
+        let pngs = pictures
+            .iter()
+            .map(|&f| match picked.iter().position(|&q| q == f) {
+                Some(k) => match &drawn[k].1 {
+                    Some(png) => Ok(png.clone()),
+                    None => self.png(Some(f), size),
+                },
+                None => self.png(Some(f), size),
+            })
+            .collect::<Result<_>>()?;
+        Ok((gif, pngs))
     }
 
     /// One state as a standalone SVG document (vector version of [`Scene::png`]).
@@ -706,6 +762,109 @@ impl<'a> Scene<'a> {
     }
 }
 
+/// A drawn picture as PNG bytes: RGB when every pixel is opaque (always, on the white
+/// background; the same colours as RGBA, a quarter fewer bytes to compress), with the
+/// `png` crate's fast DEFLATE (fdeflate): several times quicker than the default level
+/// for files about a quarter larger.
+pub(crate) fn encode_png(pm: &Pixmap) -> Result<Vec<u8>> {
+    if !pm.pixels().iter().all(|p| p.alpha() == 255) {
+        return pm
+            .encode_png()
+            .map_err(|e| ExportError::Image(e.to_string()));
+    }
+    // Opaque: premultiplied RGBA equals straight RGBA, so dropping alpha is exact.
+    let rgb: Vec<u8> = pm
+        .data()
+        .chunks_exact(4)
+        .flat_map(|px| [px[0], px[1], px[2]])
+        .collect();
+    let mut out = Vec::new();
+    let img = |e: png::EncodingError| ExportError::Image(e.to_string());
+    let mut enc = png::Encoder::new(&mut out, pm.width(), pm.height());
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_compression(png::Compression::Fast);
+    let mut writer = enc.write_header().map_err(img)?;
+    writer.write_image_data(&rgb).map_err(img)?;
+    writer.finish().map_err(img)?;
+    Ok(out)
+}
+
+/// The GIF's progress bar along the bottom edge: frame `k` of `n` (0-based) fills k/(n − 1)
+/// of the width (at least a pixel), 4 pixels high.
+fn draw_progress(pm: &mut Pixmap, k: usize, n: usize) {
+    let (w, h) = (pm.width() as f32, pm.height() as f32);
+    let frac = if n > 1 {
+        k as f32 / (n - 1) as f32
+    } else {
+        1.0
+    };
+    if let Some(rect) = tiny_skia::Rect::from_xywh(0.0, h - 4.0, (w * frac).max(1.0), 4.0) {
+        let mut p = Paint::default();
+        p.set_color_rgba8(PROGRESS.0, PROGRESS.1, PROGRESS.2, PROGRESS.3);
+        pm.fill_rect(rect, &p, Transform::identity(), None);
+    }
+}
+
+/// The palette entry of every pixel of an opaque picture, row by row.
+fn palette_indices(pm: &Pixmap, palette: &GifPalette) -> Vec<u8> {
+    // Opaque white background: premultiplied RGBA equals straight RGBA here.
+    pm.data()
+        .chunks_exact(4)
+        .map(|px| palette.index(px[0], px[1], px[2]))
+        .collect()
+}
+
+/// The GIF frame that turns picture `prev` into `cur` (both `w`×`h` palette indices) when
+/// drawn over it: the bounding rectangle of the changed pixels, unchanged ones inside it
+/// set to `transparent` (an index neither picture uses). No change: one transparent pixel.
+fn delta_frame(
+    prev: &[u8],
+    cur: &[u8],
+    w: usize,
+    h: usize,
+    transparent: u8,
+) -> gif::Frame<'static> {
+    let (mut top, mut bottom, mut left, mut right) = (h, 0, w, 0);
+    for y in 0..h {
+        let (a, b) = (&prev[y * w..(y + 1) * w], &cur[y * w..(y + 1) * w]);
+        if a == b {
+            continue;
+        }
+        // A row that differs has a first and a last differing pixel.
+        let first = a.iter().zip(b).position(|(p, q)| p != q).unwrap_or(0);
+        let last = w
+            - 1
+            - a.iter()
+                .rev()
+                .zip(b.iter().rev())
+                .position(|(p, q)| p != q)
+                .unwrap_or(0);
+        top = top.min(y);
+        bottom = y;
+        left = left.min(first);
+        right = right.max(last);
+    }
+    if top > bottom {
+        return gif::Frame::from_indexed_pixels(1, 1, vec![transparent], Some(transparent));
+    }
+    let (fw, fh) = (right - left + 1, bottom - top + 1);
+    let mut buf = Vec::with_capacity(fw * fh);
+    for y in top..=bottom {
+        let row = y * w + left..y * w + right + 1;
+        buf.extend(
+            prev[row.clone()]
+                .iter()
+                .zip(&cur[row])
+                .map(|(&p, &q)| if p == q { transparent } else { q }),
+        );
+    }
+    let mut frame = gif::Frame::from_indexed_pixels(fw as u16, fh as u16, buf, Some(transparent));
+    frame.left = left as u16;
+    frame.top = top as u16;
+    frame
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -763,35 +922,105 @@ mod tests {
     }
 
     #[test]
+    fn the_transparent_entry_is_one_no_colour_maps_to() {
+        let pal = gif_palette();
+        let t = pal.transparent().expect("the palette has an unused entry");
+        // Every cell of the 32³ table, i.e. every colour there is.
+        for cell in 0..1usize << 15 {
+            let (r, g, b) = (
+                (cell >> 10) as u8,
+                (cell >> 5 & 31) as u8,
+                (cell & 31) as u8,
+            );
+            assert_ne!(pal.index(r << 3, g << 3, b << 3), t);
+        }
+    }
+
+    /// The GIF's frames composed as a viewer does (each image drawn over the canvas at its
+    /// offset, transparent pixels leaving the canvas as it was), as palette indices.
+    fn composed_frames(bytes: &[u8]) -> Vec<(u16, Vec<u8>)> {
+        let mut opts = gif::DecodeOptions::new();
+        opts.set_color_output(gif::ColorOutput::Indexed);
+        let mut dec = opts.read_info(bytes).unwrap();
+        let w = usize::from(dec.width());
+        let mut canvas = vec![0u8; w * usize::from(dec.height())];
+        let mut out = Vec::new();
+        while let Some(f) = dec.read_next_frame().unwrap() {
+            assert_eq!(f.dispose, gif::DisposalMethod::Keep);
+            let fw = usize::from(f.width);
+            for (i, &px) in f.buffer.iter().enumerate() {
+                if Some(px) != f.transparent {
+                    let (x, y) = (usize::from(f.left) + i % fw, usize::from(f.top) + i / fw);
+                    canvas[y * w + x] = px;
+                }
+            }
+            out.push((f.delay, canvas.clone()));
+        }
+        out
+    }
+
+    #[test]
     fn gif_frames_are_the_pictures_in_the_palette() {
         let p = samples::single_crease(2.0, 20);
         let meta = DesignMeta::default();
         let scene = Scene::new(&p, &meta, Camera::default()).unwrap();
+        let pal = gif_palette();
         let bytes = scene.gif((96, 72), 4, 5).unwrap();
-        let mut opts = gif::DecodeOptions::new();
-        opts.set_color_output(gif::ColorOutput::RGBA);
-        let mut dec = opts.read_info(bytes.as_slice()).unwrap();
         let picked = super::super::picked_frames(p.frames.len(), 5);
-        let mut k = 0;
-        while let Some(f) = dec.read_next_frame().unwrap() {
-            // The decoded frame is the rendered picture (progress bar aside) up to the
-            // palette: small errors on average, none far off on the paper.
-            let pm = scene.pixmap(Some(picked[k]), (96, 72)).unwrap();
-            let rows = 72 - 4;
+        let frames = composed_frames(&bytes);
+        assert_eq!(frames.len(), picked.len());
+        for (k, (_, canvas)) in frames.iter().enumerate() {
+            // Composed, each frame is exactly its picture (with the progress bar) mapped
+            // through the palette, although frames after the first hold only what changed.
+            let mut pm = scene.pixmap(Some(picked[k]), (96, 72)).unwrap();
+            draw_progress(&mut pm, k, picked.len());
+            assert_eq!(*canvas, palette_indices(&pm, pal), "frame {k}");
+            // And the palette keeps the picture: small errors on average.
             let mut sum = 0u64;
-            for (a, b) in pm.data()[..96 * rows * 4]
-                .chunks_exact(4)
-                .zip(f.buffer.chunks_exact(4))
-            {
-                for i in 0..3 {
-                    sum += (a[i] as i64 - b[i] as i64).unsigned_abs();
+            for (a, &i) in pm.data().chunks_exact(4).zip(canvas) {
+                let c = pal.color(i);
+                for j in 0..3 {
+                    sum += (a[j] as i64 - c[j] as i64).unsigned_abs();
                 }
             }
-            let mean = sum as f64 / (96 * rows * 3) as f64;
+            let mean = sum as f64 / (96 * 72 * 3) as f64;
             assert!(mean < 3.0, "frame {k}: mean error {mean}");
-            k += 1;
         }
-        assert_eq!(k, picked.len());
+    }
+
+    #[test]
+    fn a_delta_frame_is_the_changed_rectangle() {
+        let (w, h, t) = (6, 5, 255u8);
+        let prev = vec![1u8; w * h];
+        let mut cur = prev.clone();
+        cur[w + 2] = 7; // (2, 1)
+        cur[3 * w + 4] = 8; // (4, 3)
+        cur[3 * w + 3] = 1; // unchanged inside the rectangle
+        let f = delta_frame(&prev, &cur, w, h, t);
+        assert_eq!((f.left, f.top, f.width, f.height), (2, 1, 3, 3));
+        assert_eq!(f.transparent, Some(t));
+        assert_eq!(&*f.buffer, &[7, t, t, t, t, t, t, t, 8]);
+        let same = delta_frame(&prev, &prev, w, h, t);
+        assert_eq!((same.width, same.height, &*same.buffer), (1, 1, &[t][..]));
+    }
+
+    #[test]
+    fn pngs_drawn_with_the_gif_are_the_pictures() {
+        let p = samples::single_crease(2.0, 20);
+        let meta = DesignMeta::default();
+        let scene = Scene::new(&p, &meta, Camera::default()).unwrap();
+        // Frame 3 is in the GIF (all 20 frames), frame 5 is not when only 5 are picked.
+        for (max_frames, states) in [(60, vec![3, 19]), (5, vec![5, 19])] {
+            let (_, pngs) = scene
+                .gif_and_pngs((96, 72), 4, max_frames, &states)
+                .unwrap();
+            assert_eq!(pngs.len(), states.len());
+            for (png, &k) in pngs.iter().zip(&states) {
+                let img = Pixmap::decode_png(png).unwrap();
+                let pm = scene.pixmap(Some(k), (96, 72)).unwrap();
+                assert_eq!(img.data(), pm.data(), "state {k}");
+            }
+        }
     }
 
     #[test]
