@@ -463,7 +463,8 @@ impl<P: Problem> Lagrangian<'_, P> {
 fn gives_up(opts: &Options, starts_run: usize, best_feasible_f: f64) -> bool {
     match opts.target {
         Some(t) if t > 0.0 && opts.give_up_after > 0 && starts_run >= opts.give_up_after => {
-            !(best_feasible_f <= opts.give_up_factor.max(1.0) * t)
+            // Never NaN: only finite objectives count as feasible, and `max` drops a NaN factor.
+            best_feasible_f > opts.give_up_factor.max(1.0) * t
         }
         _ => false,
     }
