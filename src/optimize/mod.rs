@@ -7,7 +7,9 @@
 //!   `λ_k ← max(0, λ_k − μ g_k)`, μ raised while the violation does not shrink;
 //! - each subproblem by argmin's L-BFGS with a Moré–Thuente line search;
 //! - many deterministic starts from a randomly shifted Halton sequence across the box,
-//!   stopping early once a start meets the target feasibly.
+//!   stopping early once a start meets the target feasibly, or giving up after
+//!   [`Options::give_up_after`] starts none of which came within
+//!   [`Options::give_up_factor`] of the target (issue 14).
 //!
 //! The optimizer sees the problem only through [`Problem::eval`] (objective, constraints
 //! and their gradients in one call), i.e. the compiled model.
@@ -133,6 +135,14 @@ pub struct Options {
     /// Phase B is tried on at most this many starts per problem (later starts still run
     /// phase A and count when the block accepts them as they are).
     pub robust_starts: usize,
+    /// Give up on a problem with a positive target after this many starts (0: never) when
+    /// none of them found a feasible point with `f ≤ give_up_factor · target`: the rest of
+    /// the starts would mostly go to alternatives that never reach the threshold (issue 14).
+    /// Default 10 (of 16) with factor 4: after 8 starts the gripper kept too few designs
+    /// (743, merged with main's code of 2 Dec 2026); see README for the measured effect.
+    pub give_up_after: usize,
+    /// See [`Options::give_up_after`]; values below 1 count as 1.
+    pub give_up_factor: f64,
 }
 
 impl Default for Options {
@@ -148,6 +158,8 @@ impl Default for Options {
             robust_outer: 20,
             robust_inner: 100,
             robust_starts: 4,
+            give_up_after: 10,
+            give_up_factor: 4.0,
         }
     }
 }
@@ -445,6 +457,18 @@ impl<P: Problem> Lagrangian<'_, P> {
     }
 }
 
+/// Whether [`Options::give_up_after`] stops a problem after `starts_run` starts whose
+/// best feasible objective is `best_feasible_f` (infinite when none was feasible).
+fn gives_up(opts: &Options, starts_run: usize, best_feasible_f: f64) -> bool {
+    match opts.target {
+        Some(t) if t > 0.0 && opts.give_up_after > 0 && starts_run >= opts.give_up_after => {
+            // Never NaN: only finite objectives count as feasible, and `max` drops a NaN factor.
+            best_feasible_f > opts.give_up_factor.max(1.0) * t
+        }
+        _ => false,
+    }
+}
+
 /// Minimize `problem` from many starts (see the module docs).
 pub fn minimize<P: Problem>(problem: &P, opts: &Options) -> Solution {
     minimize_robust(problem, None, opts)
@@ -465,7 +489,11 @@ pub fn minimize_robust<P: Problem>(
     let mut evaluations = 0;
     let mut attempts = 0;
     let points = quasi_random_points(n, opts.starts, opts.seed);
+    // Best feasible phase-A objective so far, for the give-up rule.
+    let mut best_feasible_f = f64::INFINITY;
+    let mut starts_run = 0;
     for (start, u) in points.iter().enumerate() {
+        starts_run = start + 1;
         // Starting points stay off the bounds, where the transform's slope vanishes.
         let x0: Vec<f64> = u
             .iter()
@@ -520,6 +548,9 @@ pub fn minimize_robust<P: Problem>(
         let violation = eval.violation();
         let feasible = violation <= opts.feasibility_tol && eval.f.is_finite();
         let met = feasible && opts.target.is_some_and(|t| eval.f <= t);
+        if feasible {
+            best_feasible_f = best_feasible_f.min(eval.f);
+        }
         let candidate = Solution {
             x,
             f: eval.f,
@@ -556,13 +587,13 @@ pub fn minimize_robust<P: Problem>(
             None => met,
             Some(_) => met && robust_ok == Some(true),
         };
-        if done {
+        if done || gives_up(opts, start + 1, best_feasible_f) {
             break;
         }
     }
     let mut best = best.expect("at least one start");
     let done = best.met_target && best.robust != Some(false);
-    best.starts_run = if done { best.start + 1 } else { points.len() };
+    best.starts_run = if done { best.start + 1 } else { starts_run };
     best.evaluations = evaluations + counter.get();
     best.robust_attempts = attempts;
     best
@@ -638,5 +669,94 @@ mod tests {
                 "dimension {d}: {bins:?}"
             );
         }
+    }
+
+    /// A double well on [-2, 2]: `(x² − 1)² + (1 − x)/2`, with a local minimum f ≈ 0.98 near
+    /// x = −0.93 and the global one f ≈ −0.015 near x = 1.06.
+    struct DoubleWell;
+
+    impl Problem for DoubleWell {
+        fn n_vars(&self) -> usize {
+            1
+        }
+        fn n_constraints(&self) -> usize {
+            0
+        }
+        fn bounds(&self, _: usize) -> (f64, f64) {
+            (-2.0, 2.0)
+        }
+        fn eval(&self, x: &[f64], out: &mut Evaluation) {
+            let x = x[0];
+            out.f = (x * x - 1.0).powi(2) + 0.5 * (1.0 - x);
+            out.df[0] = 4.0 * x * (x * x - 1.0) - 0.5;
+        }
+    }
+
+    /// A bowl whose minimum, 10 at x = 1, lies far above any target below 2.5.
+    struct HighBowl;
+
+    impl Problem for HighBowl {
+        fn n_vars(&self) -> usize {
+            1
+        }
+        fn n_constraints(&self) -> usize {
+            0
+        }
+        fn bounds(&self, _: usize) -> (f64, f64) {
+            (-2.0, 2.0)
+        }
+        fn eval(&self, x: &[f64], out: &mut Evaluation) {
+            out.f = 10.0 + (x[0] - 1.0).powi(2);
+            out.df[0] = 2.0 * (x[0] - 1.0);
+        }
+    }
+
+    #[test]
+    fn gives_up_after_k_starts_far_above_the_target_and_not_within_the_factor() {
+        let opts = |after, factor| Options {
+            starts: 12,
+            target: Some(1.0),
+            give_up_after: after,
+            give_up_factor: factor,
+            ..Options::default()
+        };
+        // min f = 10: more than 4 × the target, so 3 starts and no more.
+        let s = minimize(&HighBowl, &opts(3, 4.0));
+        assert!(s.feasible && !s.met_target, "{s:?}");
+        assert_eq!(s.starts_run, 3, "{s:?}");
+        assert!((s.f - 10.0).abs() < 1e-9, "{s:?}");
+        // Within the factor (10 ≤ 20 × 1): every start runs.
+        assert_eq!(minimize(&HighBowl, &opts(3, 20.0)).starts_run, 12);
+        // The rule off: every start runs.
+        assert_eq!(minimize(&HighBowl, &opts(0, 4.0)).starts_run, 12);
+    }
+
+    #[test]
+    fn a_start_after_k_still_runs_when_the_early_ones_are_within_the_factor() {
+        let opts = |seed, after, factor| Options {
+            starts: 16,
+            seed,
+            target: Some(0.5),
+            give_up_after: after,
+            give_up_factor: factor,
+            ..Options::default()
+        };
+        // A seed whose first start to meet the target (the global well) is the third or later:
+        // the starts before it ended in the local well, f ≈ 0.98.
+        let (seed, k) = (0..200)
+            .find_map(|seed| {
+                let s = minimize(&DoubleWell, &opts(seed, 0, 1.0));
+                (s.met_target && s.start >= 2).then_some((seed, s.start))
+            })
+            .expect("some seed starts in the local well twice");
+        // 0.98 ≤ 4 × 0.5: start k + 1 runs and meets the target.
+        let s = minimize(&DoubleWell, &opts(seed, k, 4.0));
+        assert!(s.met_target, "{s:?}");
+        assert_eq!((s.start, s.starts_run), (k, k + 1), "{s:?}");
+        // 0.98 > 1.5 × 0.5: after k starts it gives up, at the local minimum.
+        let s = minimize(&DoubleWell, &opts(seed, k, 1.5));
+        assert!(s.feasible && !s.met_target, "{s:?}");
+        assert_eq!(s.starts_run, k, "{s:?}");
+        assert!((s.f - 0.98).abs() < 0.01, "{s:?}");
     }
 }
