@@ -97,6 +97,10 @@ fn sweep(g: &mut ExprGraph, output: NodeId, n_vars: usize) -> Vec<NodeId> {
                 continue;
             }
             let Some(a) = s.adj[i] else { continue };
+            // A constant zero adjoint passes nothing on (no `0 · x`, issue 18).
+            if s.g.const_value(a) == Some(0.0) {
+                continue;
+            }
             let id = NodeId(i as u32);
             if let Node::Var(k) = *s.g.node(id) {
                 grad[k as usize] = Some(a);
@@ -108,9 +112,6 @@ fn sweep(g: &mut ExprGraph, output: NodeId, n_vars: usize) -> Vec<NodeId> {
                     // d(x/y) = a/y·dx − (a/y)·(x/y)·dy
                     let r = recip(s.g, y);
                     let r = scale(s.g, a, r);
-                    if s.g.const_value(r) == Some(0.0) {
-                        continue;
-                    }
                     s.acc(x, r);
                     if dep[y.index()] {
                         let c = s.g.add(Node::Mul(r, id));
@@ -121,9 +122,6 @@ fn sweep(g: &mut ExprGraph, output: NodeId, n_vars: usize) -> Vec<NodeId> {
                 Node::Atan2(y, x) => {
                     let w = atan2_weight(s.g, y, x);
                     let w = scale(s.g, a, w);
-                    if s.g.const_value(w) == Some(0.0) {
-                        continue;
-                    }
                     if dep[y.index()] {
                         let c = s.g.add(Node::Mul(w, x));
                         s.acc(y, c);
