@@ -569,11 +569,26 @@ impl RobustModel {
         &self,
         pos: &[[f64; 2]],
         level: Level,
+        visit: impl FnMut(usize, f64, &[(usize, [f64; 2])]),
+    ) {
+        self.visit_features_where(pos, level, |_| false, visit);
+    }
+
+    /// [`RobustModel::visit_features`] without the slots `skip_if_clear` allows to skip
+    /// when they hold (`h ≥ 0`, found from squared distances without a square root): a
+    /// slot with multiplier 0 that holds adds exactly nothing to the merit, to the
+    /// multiplier update or to the largest violation, and most slots are such (issue 14).
+    fn visit_features_where(
+        &self,
+        pos: &[[f64; 2]],
+        level: Level,
+        skip_if_clear: impl Fn(usize) -> bool,
         mut visit: impl FnMut(usize, f64, &[(usize, [f64; 2])]),
     ) {
         let Some(req) = self.feature_required(level) else {
             return;
         };
+        let req2 = req * req;
         let n = pos.len();
         let unit = |r: [f64; 2], d: f64| {
             if d > 0.0 {
@@ -586,7 +601,13 @@ impl RobustModel {
         for a in 0..n {
             for b in a + 1..n {
                 let r = [pos[a][0] - pos[b][0], pos[a][1] - pos[b][1]];
-                let d = r[0].hypot(r[1]);
+                let d2 = r[0] * r[0] + r[1] * r[1];
+                if d2 >= req2 && skip_if_clear(slot) {
+                    slot += 1;
+                    continue;
+                }
+                // Paper coordinates are O(1): no overflow for hypot to guard against.
+                let d = d2.sqrt();
                 let u = unit(r, d);
                 visit(slot, d - req, &[(a, u), (b, [-u[0], -u[1]])]);
                 slot += 1;
@@ -605,7 +626,12 @@ impl RobustModel {
                         0.0
                     };
                     let r = [p[0] - a[0] - s * e[0], p[1] - a[1] - s * e[1]];
-                    let d = r[0].hypot(r[1]);
+                    let d2 = r[0] * r[0] + r[1] * r[1];
+                    if d2 >= req2 && skip_if_clear(slot) {
+                        slot += 1;
+                        continue;
+                    }
+                    let d = d2.sqrt();
                     let u = unit(r, d);
                     let ga = [-(1.0 - s) * u[0], -(1.0 - s) * u[1]];
                     let gb = [-s * u[0], -s * u[1]];
@@ -640,17 +666,22 @@ impl RobustModel {
         } = work;
         w.iter_mut().for_each(|w| *w = 0.0);
         let mut value = 0.0;
-        self.visit_features(flat, Level::Imposed, |slot, h, dx| {
-            let l = lambda[slot];
-            let a = (l - mu * h).max(0.0);
-            value += (a * a - l * l) / (2.0 * mu);
-            if a > 0.0 {
-                for (v, g) in dx {
-                    w[2 * v] -= a * g[0];
-                    w[2 * v + 1] -= a * g[1];
+        self.visit_features_where(
+            flat,
+            Level::Imposed,
+            |k| lambda[k] == 0.0,
+            |slot, h, dx| {
+                let l = lambda[slot];
+                let a = (l - mu * h).max(0.0);
+                value += (a * a - l * l) / (2.0 * mu);
+                if a > 0.0 {
+                    for (v, g) in dx {
+                        w[2 * v] -= a * g[0];
+                        w[2 * v + 1] -= a * g[1];
+                    }
                 }
-            }
-        });
+            },
+        );
         for (k, wk) in w.iter().enumerate().filter(|(_, wk)| **wk != 0.0) {
             for (g, d) in grad
                 .iter_mut()
@@ -770,12 +801,18 @@ impl<'a> RobustProblem<'a> {
         b.eval_flat(x, work);
         let mut lambda = self.feature_lambda.borrow_mut();
         let mut worst = 0.0_f64;
-        b.visit_features(&work.flat, Level::Imposed, |slot, h, _| {
-            if let Some(mu) = mu {
-                lambda[slot] = (lambda[slot] - mu * h).max(0.0);
-            }
-            worst = worst.max(-h);
-        });
+        let zero: Vec<bool> = lambda.iter().map(|l| *l == 0.0).collect();
+        b.visit_features_where(
+            &work.flat,
+            Level::Imposed,
+            |k| zero[k],
+            |slot, h, _| {
+                if let Some(mu) = mu {
+                    lambda[slot] = (lambda[slot] - mu * h).max(0.0);
+                }
+                worst = worst.max(-h);
+            },
+        );
         worst
     }
 
@@ -785,7 +822,7 @@ impl<'a> RobustProblem<'a> {
         self.block.eval_flat(x, &mut work);
         let mut ok = true;
         self.block
-            .visit_features(&work.flat, level, |_, h, _| ok &= h >= -1e-12);
+            .visit_features_where(&work.flat, level, |_| true, |_, h, _| ok &= h >= -1e-12);
         ok
     }
 
