@@ -13,7 +13,7 @@
 
 use crate::geom;
 use crate::kinematics::{closure_residual, wrap_angle};
-use crate::model::geometry::units;
+use crate::model::geometry::{Folded, units};
 use crate::model::numeric::Evaluated;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -133,6 +133,18 @@ impl VerifyReport {
 /// Verify `design` at the states `ts` (the sweep; the last one is taken as t_max for
 /// the thesis-style check).
 pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyReport {
+    let folds: Vec<Folded<f64>> = ts.iter().map(|&t| design.fold(t)).collect();
+    verify_folded(design, ts, &folds, tol)
+}
+
+/// [`verify`] on states already folded at `ts` (`folds[i]` at `ts[i]`, from
+/// [`Evaluated::fold`]): what is checked are those states' geometry and angles.
+pub fn verify_folded(
+    design: &Evaluated<'_>,
+    ts: &[f64],
+    folds: &[Folded<f64>],
+    tol: &Tolerances,
+) -> VerifyReport {
     let plan = design.plan;
     let flat = &design.flat;
     let mut r = VerifyReport {
@@ -173,8 +185,7 @@ pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyRep
     }
 
     let flat3: Vec<[f64; 3]> = flat.pos.iter().map(|p| [p[0], p[1], 0.0]).collect();
-    for (si, &t) in ts.iter().enumerate() {
-        let folded = design.fold(t);
+    for (si, (&t, folded)) in ts.iter().zip(folds).enumerate() {
         // Rigidity first: the geometry of a state is only defined where every vertex is.
         let mut rigid = true;
         let mut state_margin = f64::INFINITY;
@@ -203,7 +214,7 @@ pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyRep
             continue;
         }
         r.rigid_states += 1;
-        let x = design.coords(&folded);
+        let x = design.coords(folded);
         // Isometry, relative to each facet's size.
         for (poly, _) in &plan.polygons {
             let size = poly

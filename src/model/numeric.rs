@@ -103,18 +103,25 @@ impl<'a> Evaluated<'a> {
 
     /// The pattern with frames at the given values of t.
     pub fn pattern(&self, ts: &[f64]) -> Pattern {
+        let folds: Vec<Folded<f64>> = ts.iter().map(|&t| self.fold(t)).collect();
+        self.pattern_of(ts, &folds)
+    }
+
+    /// [`Evaluated::pattern`] from states already folded at `ts` (`folds[i]` at `ts[i]`),
+    /// so that the search folds each state once for the pattern and for `check::verify`.
+    pub fn pattern_of(&self, ts: &[f64], folds: &[Folded<f64>]) -> Pattern {
         let edges = self.edges();
         let ncreases = self.plan.creases.len();
         let frames = ts
             .iter()
-            .map(|&t| {
-                let folded = self.fold(t);
+            .zip(folds)
+            .map(|(&t, folded)| {
                 let mut fold_angles: Vec<f64> = folded.rho.iter().map(|r| wrap_angle(*r)).collect();
                 fold_angles.resize(edges.len(), 0.0);
                 debug_assert!(fold_angles.len() >= ncreases);
                 Frame {
                     t,
-                    coords: self.coords(&folded),
+                    coords: self.coords(folded),
                     fold_angles,
                 }
             })

@@ -6,7 +6,7 @@ use super::progress::Progress;
 use super::record::{AlternativeRecord, RankEntry, Summary, Tally, Timings};
 use super::report::{report_design, report_input, task_facts};
 use crate::check::robustness::{self, RobustnessInput, UnitCreases};
-use crate::check::verify::{Tolerances, verify};
+use crate::check::verify::{Tolerances, verify_folded};
 use crate::check::{CheckError, Checker, Cylinder, MotionSettings, check_states, two_armed};
 use crate::compile::Options as CompileOptions;
 use crate::cpu_time::Stopwatch;
@@ -324,7 +324,10 @@ fn evaluate(
     let design = Evaluated::new(&model.plan, full, modes);
     // The judges run on the dense verification sweep, not only on the states the optimizer
     // saw, so an intersection between sampled states cannot hide.
-    let arm = design.pattern(&sample_times(model.t_max, opts.sweep));
+    // Each state folded once, for the pattern the checks judge and for `verify`.
+    let sweep = sample_times(model.t_max, opts.sweep);
+    let folds: Vec<_> = sweep.iter().map(|&t| design.fold(t)).collect();
+    let arm = design.pattern_of(&sweep, &folds);
     let checked = checked_pattern(task, &arm)
         .map_err(CheckFailure::Other)
         .and_then(|pat| {
@@ -374,7 +377,7 @@ fn evaluate(
         }
     }
     let tol = Tolerances::default();
-    let report = verify(&design, &sample_times(model.t_max, opts.sweep), &tol);
+    let report = verify_folded(&design, &sweep, &folds, &tol);
     let failed = !report.geometry_passes(&tol);
     if failed && model.plan.sinks.is_empty() {
         eprintln!(
