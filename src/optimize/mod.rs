@@ -244,20 +244,19 @@ impl Transform {
         self.x_into(y, &mut x, None);
         x
     }
-    /// `x(y)` into `x` and, with `slope`, `dx/dy` into it (one `sin_cos` per variable, the
-    /// crate's fdlibm kernel as in the compiled models).
-    fn x_into(&self, y: &[f64], x: &mut Vec<f64>, mut slope: Option<&mut Vec<f64>>) {
-        x.clear();
-        if let Some(d) = slope.as_deref_mut() {
-            d.clear();
-        }
-        for (i, y) in y.iter().enumerate() {
-            let (s, c) = crate::trig::sin_cos(*y);
+    /// `x(y)` into `x` and, with `slope`, `dx/dy` into it: one batched `sin_cos` over all
+    /// variables (the crate's fdlibm kernels, as in the compiled models).
+    fn x_into(&self, y: &[f64], x: &mut Vec<f64>, slope: Option<&mut Vec<f64>>) {
+        let n = y.len();
+        let mut spare = Vec::new();
+        let c = slope.unwrap_or(&mut spare);
+        x.resize(n, 0.0);
+        c.resize(n, 0.0);
+        crate::trig::batch::sin_cos(y, x, c);
+        for i in 0..n {
             let half = (self.hi[i] - self.lo[i]) * 0.5;
-            x.push(self.lo[i] + half * (1.0 + s));
-            if let Some(d) = slope.as_deref_mut() {
-                d.push(half * c);
-            }
+            x[i] = self.lo[i] + half * (1.0 + x[i]);
+            c[i] *= half;
         }
     }
     fn y(&self, x: &[f64]) -> Vec<f64> {

@@ -331,12 +331,16 @@ fn evaluate(
     let checked = checked_pattern(task, &arm)
         .map_err(CheckFailure::Other)
         .and_then(|pat| {
-            let checker = Checker::from_pattern(&pat).map_err(|e| match e {
+            let mut checker = Checker::from_pattern(&pat).map_err(|e| match e {
                 // A facet that cannot be triangulated is inverted or overlaps itself in the
                 // flat layout: the paper crosses itself before it folds.
                 CheckError::Triangulate(t) => CheckFailure::Layout(t.to_string()),
                 e => CheckFailure::Other(e.to_string()),
             })?;
+            if pat.faces.len() > arm.faces.len() {
+                // `two_armed`: the second arm is the first turned by exactly 180°.
+                checker = checker.with_half_turn_copy(arm.faces.len());
+            }
             let s = check_states(
                 &checker,
                 Some(&pat.vertices),
