@@ -185,6 +185,14 @@ pub fn verify_folded(
     }
 
     let flat3: Vec<[f64; 3]> = flat.pos.iter().map(|p| [p[0], p[1], 0.0]).collect();
+    // Facets whose flat normal is −z (the same at every state).
+    let flat_reversed: Vec<bool> = plan
+        .polygons
+        .iter()
+        .map(|(p, _)| {
+            geom::newell_normal(&p.iter().map(|v| flat3[*v]).collect::<Vec<_>>())[2] < 0.0
+        })
+        .collect();
     for (si, (&t, folded)) in ts.iter().zip(folds).enumerate() {
         // Rigidity first: the geometry of a state is only defined where every vertex is.
         let mut rigid = true;
@@ -246,9 +254,10 @@ pub fn verify_folded(
         let facet_points: Vec<Vec<[f64; 3]>> = plan
             .polygons
             .iter()
-            .map(|(p, _)| {
+            .zip(&flat_reversed)
+            .map(|((p, _), &reversed)| {
                 let mut pts: Vec<[f64; 3]> = p.iter().map(|v| x[*v]).collect();
-                if geom::newell_normal(&p.iter().map(|v| flat3[*v]).collect::<Vec<_>>())[2] < 0.0 {
+                if reversed {
                     pts.reverse();
                 }
                 pts
