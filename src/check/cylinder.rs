@@ -215,13 +215,9 @@ mod tests {
     #[test]
     fn hits_agrees_with_the_clipped_distance() {
         let c = Cylinder::thesis_gripper();
-        let mut state = 0x853c_49e6_748f_ea9b_u64;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2);
+        let mut rnd = move || rng.random_range(-1.0..1.0);
         let (mut hit, mut miss) = (0, 0);
         for k in 0..20000 {
             let size = [0.05, 0.3, 1.0][k % 3];

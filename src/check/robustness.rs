@@ -851,13 +851,9 @@ mod tests {
     /// fans about a common apex, spread from touching to far apart.
     #[test]
     fn pruning_bounds_never_exceed_the_exact_values() {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        let mut rnd = move || rng.random_range(-1.0..1.0);
         let mut pruned = 0;
         for k in 0..4000 {
             let spread = [0.1, 0.5, 2.0, 5.0][k % 4];

@@ -606,13 +606,9 @@ mod tests {
     fn half_turn_copies_cross_where_their_originals_do() {
         use crate::check::rotated_copy::two_armed;
         use crate::pattern::Frame;
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut rnd = move || rng.random_range(0.0..1.0);
         let square = |x0: f64, y0: f64| {
             [
                 [x0, y0],

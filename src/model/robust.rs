@@ -801,14 +801,15 @@ impl<'a> RobustProblem<'a> {
         b.eval_flat(x, work);
         let mut lambda = self.feature_lambda.borrow_mut();
         let mut worst = 0.0_f64;
-        let zero: Vec<bool> = lambda.iter().map(|l| *l == 0.0).collect();
+        // Read by the skip test and written by the update: shared as cells.
+        let lambda = std::cell::Cell::from_mut(&mut lambda[..]).as_slice_of_cells();
         b.visit_features_where(
             &work.flat,
             Level::Imposed,
-            |k| zero[k],
+            |k| lambda[k].get() == 0.0,
             |slot, h, _| {
                 if let Some(mu) = mu {
-                    lambda[slot] = (lambda[slot] - mu * h).max(0.0);
+                    lambda[slot].set((lambda[slot].get() - mu * h).max(0.0));
                 }
                 worst = worst.max(-h);
             },
