@@ -265,14 +265,19 @@ pub(crate) fn emit_atan2<O: Ops>(o: &mut O, y: O::V, x: O::V) -> O::V {
         o.add(d, lo)
     };
     let r = o.sign_select(swap, r2, r);
-    // x negative (−0 included): π − r.
+    // x negative (−0 included): π − r. Except x = ±0 with y ≠ 0, whose angle is ±π/2
+    // either way: π − π/2 would round to one ulp above π/2, so acos(−0) ≠ acos(+0).
     let r3 = {
         let hi = o.c(PI_HI);
         let lo = o.c(PI_LO);
         let d = o.sub(hi, r);
         o.add(d, lo)
     };
-    let r = o.sign_select(x, r3, r);
+    let side = {
+        let y_zero = o.eq_select(ay, zero, x, zero);
+        o.eq_select(ax, zero, y_zero, x)
+    };
+    let r = o.sign_select(side, r3, r);
     o.copysign(r, y)
 }
 
@@ -728,6 +733,18 @@ mod tests {
         for v in [1.1e6, -3e9, 1e300] {
             assert_eq!(sin_cos(v), (v.sin(), v.cos()));
         }
+        // The sign of a zero x does not move ±π/2 (the C library's exact values), so
+        // acos(−0) = acos(+0): the expression graph folds −0 to +0.
+        for y in [1.0, -1.0, 1e-300, 7.0] {
+            assert_eq!(atan2(y, -0.0), y.atan2(-0.0), "atan2({y}, -0)");
+            assert_eq!(
+                atan2(y, -0.0).to_bits(),
+                atan2(y, 0.0).to_bits(),
+                "atan2({y}, ±0)"
+            );
+        }
+        assert_eq!(acos(-0.0).to_bits(), acos(0.0).to_bits());
+        assert_eq!(acos(0.0), std::f64::consts::FRAC_PI_2);
         assert_eq!(acos(1.0), 0.0);
         assert_eq!(acos(7.0), 0.0);
         assert_eq!(acos(-1.0), std::f64::consts::PI);
