@@ -779,5 +779,30 @@ mod tests {
         let (mut s, mut c) = (vec![0.0; n], vec![0.0; n]);
         batch::sin_cos_scalar(&xs, &mut s, &mut c);
         assert_eq!(&s[..], &out[..n]);
+        // Every length up to 9: whole vectors, scalar tails and batches shorter than one
+        // vector (the generated code's batches are often that short).
+        let same = |p: f64, q: f64| p.to_bits() == q.to_bits() || (p.is_nan() && q.is_nan());
+        for start in [0, 17, 500] {
+            for len in 0..=9 {
+                let x = &xs[start..start + len];
+                let y = &xs[start + 100..start + 100 + len];
+                let (mut s, mut c, mut at, mut ac) = (
+                    vec![9.0; len],
+                    vec![9.0; len],
+                    vec![9.0; len],
+                    vec![9.0; len],
+                );
+                batch::sin_cos(x, &mut s, &mut c);
+                batch::atan2(y, x, &mut at);
+                let a: Vec<f64> = x.iter().map(|v| v.clamp(-1.5, 1.5)).collect();
+                batch::acos(&a, &mut ac);
+                for i in 0..len {
+                    let (s1, c1) = sin_cos(x[i]);
+                    assert!(same(s[i], s1) && same(c[i], c1), "sin_cos({})", x[i]);
+                    assert!(same(at[i], atan2(y[i], x[i])), "atan2({}, {})", y[i], x[i]);
+                    assert!(same(ac[i], acos(a[i])), "acos({})", a[i]);
+                }
+            }
+        }
     }
 }

@@ -5,7 +5,7 @@
 use super::{Model, geometry};
 use crate::compile::{self, Compiled, Options};
 use crate::cpu_time::Stopwatch;
-use crate::expr::{Ctx, Sym};
+use crate::expr::{Ctx, Node, Sym};
 use crate::optimize::{Evaluation, Problem};
 use std::cell::RefCell;
 
@@ -26,6 +26,11 @@ pub struct CompiledModel {
     /// Milliseconds from the start of the build to native code (build, simplify,
     /// differentiate, compile; CPU time).
     pub total_ms: f64,
+    /// Per internal vertex: whether its mode reaches any output. Modes that do not (a
+    /// vertex outside the gripping vertex's chain that no constraint sees) leave the
+    /// compiled function unchanged bit for bit, so the alternatives that differ only there
+    /// are one optimization problem.
+    pub modes_used: Vec<bool>,
 }
 
 /// The symbolic outputs of `model`: free variable `k` is `Var(k)`, the others are the
@@ -53,7 +58,24 @@ impl CompiledModel {
         let build_ms = start.cpu_ms();
         let n_params = model.plan.internal.len() + model.times.len();
         let compiled = compile::compile(&graph, &ids, model.free.len(), n_params, opts)?;
+        let n_modes = model.plan.internal.len();
+        let mut modes_used = vec![false; n_modes];
+        let reachable = compiled.graph.reachable(&compiled.outputs);
+        for (node, _) in compiled
+            .graph
+            .nodes()
+            .iter()
+            .zip(&reachable)
+            .filter(|(_, r)| **r)
+        {
+            if let Node::Param(k) = node
+                && let Some(used) = modes_used.get_mut(*k as usize)
+            {
+                *used = true;
+            }
+        }
         Ok(CompiledModel {
+            modes_used,
             n_vars: model.free.len(),
             n_constraints: ids.len() - 1,
             n_modes: model.plan.internal.len(),

@@ -11,6 +11,10 @@
 //!   [`Options::give_up_after`] starts none of which came within
 //!   [`Options::give_up_factor`] of the target (issue 14).
 //!
+//! Problems that are one function (alternatives whose differing modes reach no output of
+//! the model) can share their starts' phase A through [`SharedStarts`]: a start's phase A
+//! depends only on the problem and its starting point, so a second problem replays it.
+//!
 //! The optimizer sees the problem only through [`Problem::eval`] (objective, constraints
 //! and their gradients in one call), i.e. the compiled model.
 //!
@@ -483,6 +487,76 @@ impl<P: Problem> Lagrangian<'_, P> {
     }
 }
 
+/// The phase-A outcome of one start: where the augmented Lagrangian ended.
+#[derive(Clone, Debug)]
+struct PhaseA {
+    y: Vec<f64>,
+    lambda: Vec<f64>,
+    mu: f64,
+    met: bool,
+    /// Evaluations it took: a replay counts them too, so a record does not depend on which
+    /// member ran first (or on what a resumed run had already done).
+    evaluations: usize,
+}
+
+/// The phase-A outcomes of the starts of problems that are the same function with the same
+/// [`Options`] (issue 14: the alternatives of a model whose differing modes reach no
+/// output). The first problem to run a start records it; the others replay it, so their
+/// solutions are those they would compute themselves, without computing them (their
+/// [`Solution::evaluations`] still count the replayed ones). Phase B ([`Robust`]) is each
+/// problem's own.
+#[derive(Debug)]
+pub struct SharedStarts {
+    /// The seed of the starting points the outcomes belong to; problems of another seed
+    /// neither read nor write.
+    seed: u64,
+    starts: RefCell<Vec<Option<PhaseA>>>,
+    replayed: Cell<usize>,
+}
+
+impl SharedStarts {
+    /// Empty, for problems optimized with `Options::seed == seed`.
+    pub fn new(seed: u64) -> SharedStarts {
+        SharedStarts {
+            seed,
+            starts: RefCell::new(Vec::new()),
+            replayed: Cell::new(0),
+        }
+    }
+
+    /// The seed the outcomes belong to.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Starts replayed so far instead of computed.
+    pub fn replayed(&self) -> usize {
+        self.replayed.get()
+    }
+
+    fn get(&self, opts: &Options, start: usize) -> Option<PhaseA> {
+        if opts.seed != self.seed {
+            return None;
+        }
+        let a = self.starts.borrow().get(start).cloned().flatten();
+        if a.is_some() {
+            self.replayed.set(self.replayed.get() + 1);
+        }
+        a
+    }
+
+    fn put(&self, opts: &Options, start: usize, a: PhaseA) {
+        if opts.seed != self.seed {
+            return;
+        }
+        let mut s = self.starts.borrow_mut();
+        if s.len() <= start {
+            s.resize(start + 1, None);
+        }
+        s[start] = Some(a);
+    }
+}
+
 /// Whether [`Options::give_up_after`] stops a problem after `starts_run` starts whose
 /// best feasible objective is `best_feasible_f` (infinite when none was feasible).
 fn gives_up(opts: &Options, starts_run: usize, best_feasible_f: f64) -> bool {
@@ -507,6 +581,18 @@ pub fn minimize_robust<P: Problem>(
     robust: Option<&dyn Robust>,
     opts: &Options,
 ) -> Solution {
+    minimize_shared(problem, robust, opts, None)
+}
+
+/// [`minimize_robust`] replaying and recording the starts' phase A in `shared` (see
+/// [`SharedStarts`]): the caller vouches that every problem given the same `shared` is
+/// the same function.
+pub fn minimize_shared<P: Problem>(
+    problem: &P,
+    robust: Option<&dyn Robust>,
+    opts: &Options,
+    shared: Option<&SharedStarts>,
+) -> Solution {
     let (n, m) = (problem.n_vars(), problem.n_constraints());
     let (lo, hi): (Vec<f64>, Vec<f64>) = (0..n).map(|i| problem.bounds(i)).unzip();
     let transform = Transform { lo, hi };
@@ -518,6 +604,7 @@ pub fn minimize_robust<P: Problem>(
     // Best feasible phase-A objective so far, for the give-up rule.
     let mut best_feasible_f = f64::INFINITY;
     let mut starts_run = 0;
+    let mut replayed_evaluations = 0;
     for (start, u) in points.iter().enumerate() {
         starts_run = start + 1;
         // Starting points stay off the bounds, where the transform's slope vanishes.
@@ -540,7 +627,28 @@ pub fn minimize_robust<P: Problem>(
             eval: Evaluation::new(n, m),
             evaluations: 0,
         };
-        let met_a = al.run(None, opts.max_outer, opts.max_inner);
+        let met_a = match shared.and_then(|s| s.get(opts, start)) {
+            Some(a) => {
+                (al.y, al.lambda, al.mu) = (a.y, a.lambda, a.mu);
+                replayed_evaluations += a.evaluations;
+                a.met
+            }
+            None => {
+                let before = counter.get();
+                let met = al.run(None, opts.max_outer, opts.max_inner);
+                if let Some(s) = shared {
+                    let a = PhaseA {
+                        y: al.y.clone(),
+                        lambda: al.lambda.clone(),
+                        mu: al.mu,
+                        met,
+                        evaluations: al.evaluations + counter.get() - before,
+                    };
+                    s.put(opts, start, a);
+                }
+                met
+            }
+        };
         let mut robust_ok = None;
         let mut robust_violation = None;
         if let Some(r) = robust
@@ -620,7 +728,7 @@ pub fn minimize_robust<P: Problem>(
     let mut best = best.expect("at least one start");
     let done = best.met_target && best.robust != Some(false);
     best.starts_run = if done { best.start + 1 } else { starts_run };
-    best.evaluations = evaluations + counter.get();
+    best.evaluations = evaluations + counter.get() + replayed_evaluations;
     best.robust_attempts = attempts;
     best
 }
@@ -676,6 +784,32 @@ mod tests {
         assert!(nu > 0.0, "{s:?}");
         let res = ((df[0] - nu * dg[0]).powi(2) + (df[1] - nu * dg[1]).powi(2)).sqrt();
         assert!(res < 1e-5, "KKT residual {res} at {s:?}");
+    }
+
+    #[test]
+    fn shared_starts_replay_the_same_solution_without_evaluating() {
+        let opts = Options {
+            starts: 5,
+            seed: 3,
+            ..Options::default()
+        };
+        let alone = minimize(&DiskRosenbrock, &opts);
+        let shared = SharedStarts::new(3);
+        let first = minimize_shared(&DiskRosenbrock, None, &opts, Some(&shared));
+        let second = minimize_shared(&DiskRosenbrock, None, &opts, Some(&shared));
+        for s in [&first, &second] {
+            assert_eq!(s.x, alone.x);
+            assert_eq!(s.f.to_bits(), alone.f.to_bits());
+            assert_eq!(s.starts_run, alone.starts_run);
+        }
+        // The replay counts the evaluations it stands for.
+        assert_eq!(first.evaluations, alone.evaluations);
+        assert_eq!(second.evaluations, alone.evaluations);
+        assert_eq!(shared.replayed(), second.starts_run);
+        // Another seed neither reads nor writes the outcomes.
+        let other = Options { seed: 4, ..opts };
+        minimize_shared(&DiskRosenbrock, None, &other, Some(&shared));
+        assert_eq!(shared.replayed(), second.starts_run);
     }
 
     #[test]

@@ -17,7 +17,7 @@ use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
 use crate::model::robust::{RobustModel, RobustProblem, RobustSpec};
 use crate::model::{Model, ModelError};
-use crate::optimize::{self, minimize, minimize_robust};
+use crate::optimize::{self, SharedStarts, minimize_shared};
 use crate::pattern::Pattern;
 use crate::task::Task;
 use rayon::prelude::*;
@@ -235,13 +235,16 @@ enum CheckFailure {
     Other(String),
 }
 
-/// Optimize, check and verify one alternative.
+/// Optimize, check and verify one alternative; `shared`: the phase-A starts of its class
+/// (the alternatives of its model whose modes differ only where no output depends on
+/// them), whose seed it optimizes with.
 fn evaluate(
     task: &Task,
     p: &Prepared,
     alt: &Alternative,
     graph: &CreaseGraph,
     opts: &SearchOptions,
+    shared: &SharedStarts,
 ) -> AlternativeRecord {
     let model = &p.model;
     let modes = alt.mode_signs();
@@ -250,7 +253,7 @@ fn evaluate(
     let problem = ModelProblem::new(model, &p.compiled, &modes);
     let optimize_opts = optimize::Options {
         starts: opts.starts,
-        seed: alternative_seed(opts.seed, &key),
+        seed: shared.seed(),
         target: Some(objective_target(model)),
         max_outer: if model.plan.sinks.is_empty() {
             optimize::Options::default().max_outer
@@ -260,10 +263,10 @@ fn evaluate(
         ..Default::default()
     };
     let mut sol = match &p.robust {
-        None => minimize(&problem, &optimize_opts),
+        None => minimize_shared(&problem, None, &optimize_opts, Some(shared)),
         Some(block) => {
             let rp = RobustProblem::new(model, block, &modes);
-            minimize_robust(&problem, Some(&rp), &optimize_opts)
+            minimize_shared(&problem, Some(&rp), &optimize_opts, Some(shared))
         }
     };
     // Cyclic patterns: Newton on the compatibility equations, to rounding.
@@ -855,20 +858,38 @@ pub fn evaluate_units(
                     return;
                 }
             };
-            modes.par_iter().for_each(|&m| {
-                let alt = plan.alternative(u, m);
-                let rec = evaluate(task, &prepared, &alt, &graph, opts);
-                let mut line = serde_json::to_string(&rec).unwrap_or_default();
-                line.push('\n');
-                if let Ok(mut w) = writer.lock() {
-                    // One write per line, flushed: a kill loses at most this one.
-                    if let Err(e) = w.write_all(line.as_bytes()).and_then(|_| w.flush())
-                        && let Ok(mut first) = write_error.lock()
-                    {
-                        first.get_or_insert(e);
+            // The alternatives whose modes differ only where no output depends on them
+            // are one optimization problem: a class shares its starts' phase A, with the
+            // seed of its member whose unused modes are all up (issue 14).
+            let unused: u32 = prepared
+                .compiled
+                .modes_used
+                .iter()
+                .enumerate()
+                .filter(|(_, used)| !**used)
+                .fold(0, |acc, (i, _)| acc | 1 << i);
+            let mut classes: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+            for &m in &modes {
+                classes.entry(m & !unused).or_default().push(m);
+            }
+            classes.par_iter().for_each(|(&canonical, members)| {
+                let key = plan.alternative(u, canonical).key();
+                let shared = SharedStarts::new(alternative_seed(opts.seed, &key));
+                for &m in members {
+                    let alt = plan.alternative(u, m);
+                    let rec = evaluate(task, &prepared, &alt, &graph, opts, &shared);
+                    let mut line = serde_json::to_string(&rec).unwrap_or_default();
+                    line.push('\n');
+                    if let Ok(mut w) = writer.lock() {
+                        // One write per line, flushed: a kill loses at most this one.
+                        if let Err(e) = w.write_all(line.as_bytes()).and_then(|_| w.flush())
+                            && let Ok(mut first) = write_error.lock()
+                        {
+                            first.get_or_insert(e);
+                        }
                     }
+                    progress.inc(1);
                 }
-                progress.inc(1);
             });
             // `prepared` (the native code) is dropped here, with its last alternative.
         });
