@@ -17,7 +17,11 @@ use foldsynth::task::Task;
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::process::Command;
+
+#[path = "common/runs.rs"]
+#[allow(dead_code)] // only the runner is used here
+mod runs;
+use runs::foldsynth_ok;
 
 const GRIPPER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper.toml");
 
@@ -33,12 +37,7 @@ fn synthesize(out: &Path, extra: &[&str]) -> Value {
         "--no-export",
     ];
     args.extend_from_slice(extra);
-    let r = Command::new(env!("CARGO_BIN_EXE_foldsynth"))
-        .args(&args)
-        .output()
-        .expect("run foldsynth");
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    serde_json::from_slice(&r.stdout).unwrap()
+    serde_json::from_slice(&foldsynth_ok(&args)).unwrap()
 }
 
 fn records(out: &Path) -> BTreeMap<String, AlternativeRecord> {

@@ -19,7 +19,11 @@ use foldsynth::search::AlternativeRecord;
 use foldsynth::task::Task;
 use std::collections::BTreeMap;
 use std::path::Path;
-use std::process::Command;
+
+#[path = "common/runs.rs"]
+#[allow(dead_code)] // only the runner is used here
+mod runs;
+use runs::foldsynth_ok;
 
 const GRIPPER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper.toml");
 
@@ -34,11 +38,7 @@ fn synthesize(out: &Path, extra: &[&str]) -> Vec<AlternativeRecord> {
         "--no-export",
     ];
     args.extend_from_slice(extra);
-    let r = Command::new(env!("CARGO_BIN_EXE_foldsynth"))
-        .args(&args)
-        .output()
-        .expect("run foldsynth");
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    foldsynth_ok(&args);
     std::fs::read_to_string(out.join("alternatives.jsonl"))
         .unwrap()
         .lines()

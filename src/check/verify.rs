@@ -133,8 +133,7 @@ impl VerifyReport {
 /// Verify `design` at the states `ts` (the sweep; the last one is taken as t_max for
 /// the thesis-style check).
 pub fn verify(design: &Evaluated<'_>, ts: &[f64], tol: &Tolerances) -> VerifyReport {
-    let folds: Vec<Folded<f64>> = ts.iter().map(|&t| design.fold(t)).collect();
-    verify_folded(design, ts, &folds, tol)
+    verify_folded(design, ts, &design.fold_all(ts), tol)
 }
 
 /// [`verify`] on states already folded at `ts` (`folds[i]` at `ts[i]`, from

@@ -103,8 +103,12 @@ impl<'a> Evaluated<'a> {
 
     /// The pattern with frames at the given values of t.
     pub fn pattern(&self, ts: &[f64]) -> Pattern {
-        let folds: Vec<Folded<f64>> = ts.iter().map(|&t| self.fold(t)).collect();
-        self.pattern_of(ts, &folds)
+        self.pattern_of(ts, &self.fold_all(ts))
+    }
+
+    /// The folded state at each of `ts`.
+    pub fn fold_all(&self, ts: &[f64]) -> Vec<Folded<f64>> {
+        ts.iter().map(|&t| self.fold(t)).collect()
     }
 
     /// [`Evaluated::pattern`] from states already folded at `ts` (`folds[i]` at `ts[i]`),

@@ -329,7 +329,7 @@ fn evaluate(
     // saw, so an intersection between sampled states cannot hide.
     // Each state folded once, for the pattern the checks judge and for `verify`.
     let sweep = sample_times(model.t_max, opts.sweep);
-    let folds: Vec<_> = sweep.iter().map(|&t| design.fold(t)).collect();
+    let folds = design.fold_all(&sweep);
     let arm = design.pattern_of(&sweep, &folds);
     let checked = checked_pattern(task, &arm)
         .map_err(CheckFailure::Other)

@@ -1,10 +1,23 @@
-//! Reading a search's output folder for comparing two runs (shards merged against one
-//! machine's run): records, summary and design files without what depends on the machine
-//! and the moment.
+//! Running the binary, and reading a search's output folder for comparing two runs (shards
+//! merged against one machine's run): records, summary and design files without what
+//! depends on the machine and the moment.
 
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::process::Command;
+
+/// Run `foldsynth` with `args`, which must succeed (else its stderr is the panic message);
+/// its standard output.
+#[allow(dead_code)] // the distribute tests start the binary their own ways
+pub fn foldsynth_ok(args: &[&str]) -> Vec<u8> {
+    let r = Command::new(env!("CARGO_BIN_EXE_foldsynth"))
+        .args(args)
+        .output()
+        .expect("run foldsynth");
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    r.stdout
+}
 
 /// The records of a run by key, without the timing fields (empty when there are none).
 pub fn records(dir: &Path) -> BTreeMap<String, Value> {
