@@ -5,7 +5,8 @@
 //! - inequality constraints by an augmented Lagrangian (Powell–Hestenes–Rockafellar):
 //!   `L = f + Σ (max(0, λ_k − μ g_k)² − λ_k²) / 2μ`, multipliers updated
 //!   `λ_k ← max(0, λ_k − μ g_k)`, μ raised while the violation does not shrink;
-//! - each subproblem by argmin's L-BFGS with a Moré–Thuente line search;
+//! - each subproblem by L-BFGS with a Moré–Thuente line search (`optimize/lbfgs.rs`: argmin's
+//!   arithmetic without its allocations);
 //! - many deterministic starts from a randomly shifted Halton sequence across the box,
 //!   stopping early once a start meets the target feasibly, or giving up after
 //!   [`Options::give_up_after`] starts none of which came within
@@ -25,12 +26,11 @@
 //! block's terms in the merit (phase B: lazily added active constraints, warm-started
 //! from the unconstrained optimum). A start counts only when the block accepts it.
 
-use argmin::core::{CostFunction, Error, Executor, Gradient, State};
-use argmin::solver::linesearch::MoreThuenteLineSearch;
-use argmin::solver::quasinewton::LBFGS;
 use rand::{RngExt, SeedableRng};
 use serde::Serialize;
 use std::cell::{Cell, RefCell};
+
+mod lbfgs;
 
 /// A smooth constrained problem with box bounds.
 pub trait Problem {
@@ -278,7 +278,7 @@ impl Transform {
     }
 }
 
-/// The augmented Lagrangian of one subproblem, as argmin sees it.
+/// The augmented Lagrangian of one subproblem, as L-BFGS sees it.
 struct Merit<'a, P: Problem> {
     problem: &'a P,
     robust: Option<&'a dyn Robust>,
@@ -287,37 +287,62 @@ struct Merit<'a, P: Problem> {
     transform: &'a Transform,
     lambda: &'a [f64],
     mu: f64,
-    cache: RefCell<(Vec<f64>, f64, Vec<f64>)>,
+    /// The last point evaluated, its merit and gradient: the line search may ask again for
+    /// the point it evaluated last.
+    cache: (Vec<f64>, f64, Vec<f64>),
     /// The design variables of the last evaluation (a reused buffer).
-    x: RefCell<Vec<f64>>,
+    x: Vec<f64>,
     /// `dx/dy` there.
-    slope: RefCell<Vec<f64>>,
-    work: RefCell<Evaluation>,
+    slope: Vec<f64>,
+    work: Evaluation,
     evaluations: &'a Cell<usize>,
 }
 
-impl<P: Problem> Merit<'_, P> {
-    /// The merit and its gradient at `y` (design variables, then the block's). argmin asks
-    /// for the cost and the gradient at the same point separately: the cache answers the
-    /// second. Buffers are reused, so an evaluation allocates only the returned gradient.
-    fn compute(&self, y: &[f64]) -> (f64, Vec<f64>) {
-        {
-            let c = self.cache.borrow();
-            if c.0 == y {
-                return (c.1, c.2.clone());
-            }
+impl<'a, P: Problem> Merit<'a, P> {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        problem: &'a P,
+        robust: Option<&'a dyn Robust>,
+        transform: &'a Transform,
+        lambda: &'a [f64],
+        mu: f64,
+        n: usize,
+        evaluations: &'a Cell<usize>,
+    ) -> Self {
+        Merit {
+            problem,
+            robust,
+            n,
+            transform,
+            lambda,
+            mu,
+            cache: (Vec::new(), 0.0, Vec::new()),
+            x: Vec::new(),
+            slope: Vec::new(),
+            work: Evaluation::new(n, lambda.len()),
+            evaluations,
+        }
+    }
+}
+
+impl<P: Problem> lbfgs::Smooth for Merit<'_, P> {
+    /// The merit and its gradient at `y` (design variables, then the block's), without
+    /// allocating.
+    fn eval(&mut self, y: &[f64], grad: &mut [f64]) -> f64 {
+        if self.cache.0 == y {
+            grad.copy_from_slice(&self.cache.2);
+            return self.cache.1;
         }
         let (yd, z) = y.split_at(self.n);
-        let (mut x, mut slope) = (self.x.borrow_mut(), self.slope.borrow_mut());
-        self.transform.x_into(yd, &mut x, Some(&mut slope));
-        let mut e = self.work.borrow_mut();
-        self.problem.eval(&x, &mut e);
+        self.transform
+            .x_into(yd, &mut self.x, Some(&mut self.slope));
+        let e = &mut self.work;
+        self.problem.eval(&self.x, e);
         self.evaluations.set(self.evaluations.get() + 1);
-        let n = x.len();
+        let n = self.x.len();
         let mut value = e.f;
-        let mut grad = Vec::with_capacity(y.len());
-        grad.extend_from_slice(&e.df);
-        grad.resize(y.len(), 0.0);
+        grad[..n].copy_from_slice(&e.df);
+        grad[n..].iter_mut().for_each(|g| *g = 0.0);
         let (grad_x, grad_z) = grad.split_at_mut(n);
         for (k, g) in e.g.iter().enumerate() {
             let a = (self.lambda[k] - self.mu * g).max(0.0);
@@ -329,9 +354,9 @@ impl<P: Problem> Merit<'_, P> {
             }
         }
         if let Some(r) = self.robust {
-            value += r.merit(&x, z, self.mu, grad_x, grad_z);
+            value += r.merit(&self.x, z, self.mu, grad_x, grad_z);
         }
-        for (g, d) in grad_x.iter_mut().zip(slope.iter()) {
+        for (g, d) in grad_x.iter_mut().zip(self.slope.iter()) {
             *g *= d;
         }
         if !value.is_finite() || grad.iter().any(|g| !g.is_finite()) {
@@ -339,49 +364,38 @@ impl<P: Problem> Merit<'_, P> {
             value = 1e30;
             grad.iter_mut().for_each(|g| *g = 0.0);
         }
-        let mut c = self.cache.borrow_mut();
-        c.0.clear();
-        c.0.extend_from_slice(y);
-        c.1 = value;
-        c.2.clear();
-        c.2.extend_from_slice(&grad);
-        (value, grad)
-    }
-}
-
-impl<P: Problem> CostFunction for Merit<'_, P> {
-    type Param = Vec<f64>;
-    type Output = f64;
-    fn cost(&self, y: &Vec<f64>) -> Result<f64, Error> {
-        Ok(self.compute(y).0)
-    }
-}
-
-impl<P: Problem> Gradient for Merit<'_, P> {
-    type Param = Vec<f64>;
-    type Gradient = Vec<f64>;
-    fn gradient(&self, y: &Vec<f64>) -> Result<Vec<f64>, Error> {
-        Ok(self.compute(y).1)
+        self.cache.0.clear();
+        self.cache.0.extend_from_slice(y);
+        self.cache.1 = value;
+        self.cache.2.clear();
+        self.cache.2.extend_from_slice(grad);
+        value
     }
 }
 
 /// Minimize the merit from `y0` with L-BFGS; returns the best point (or `y0`).
-/// argmin's cost tolerance is absolute; `scale` (the merit at the start) makes it
-/// relative, so subproblems stop when they stall instead of running to the cap.
-fn lbfgs<P: Problem>(merit: Merit<'_, P>, y0: Vec<f64>, max_iters: u64, rel_tol: f64) -> Vec<f64> {
-    let scale = merit.compute(&y0).0.abs().clamp(1e-12, 1e12);
-    let solver = LBFGS::new(MoreThuenteLineSearch::new(), 8)
-        .with_tolerance_grad(1e-10)
-        .and_then(|s| s.with_tolerance_cost(rel_tol * 1e-3 * scale));
-    let Ok(solver) = solver else { return y0 };
-    match Executor::new(merit, solver)
-        .configure(|s| s.param(y0.clone()).max_iters(max_iters))
-        .run()
-    {
-        Ok(res) => res.state().get_best_param().cloned().unwrap_or(y0),
-        // A failed line search leaves the start point; the outer loop moves on.
-        Err(_) => y0,
+/// The cost tolerance is absolute; `scale` (the merit at the start) makes it relative, so
+/// subproblems stop when they stall instead of running to the cap.
+fn lbfgs<P: Problem>(
+    mut merit: Merit<'_, P>,
+    y0: Vec<f64>,
+    max_iters: u64,
+    rel_tol: f64,
+) -> Vec<f64> {
+    let mut grad = vec![0.0; y0.len()];
+    let scale = lbfgs::Smooth::eval(&mut merit, &y0, &mut grad)
+        .abs()
+        .clamp(1e-12, 1e12);
+    let settings = lbfgs::Settings {
+        memory: 8,
+        max_iters,
+        tol_grad: 1e-10,
+        tol_cost: rel_tol * 1e-3 * scale,
+    };
+    if settings.tol_cost < 0.0 {
+        return y0;
     }
+    lbfgs::minimize(&mut merit, &y0, &settings)
 }
 
 /// The state of one start's augmented Lagrangian, carried from phase A into phase B.
@@ -402,7 +416,6 @@ impl<P: Problem> Lagrangian<'_, P> {
     /// meets the target must also pass [`Robust::accept`]. Returns whether it did.
     fn run(&mut self, robust: Option<&dyn Robust>, max_outer: usize, max_inner: u64) -> bool {
         let opts = self.opts;
-        let m = self.lambda.len();
         let n = self.y.len();
         let mut prev_violation = f64::INFINITY;
         let mut prev_f = f64::INFINITY;
@@ -411,19 +424,15 @@ impl<P: Problem> Lagrangian<'_, P> {
         // target.
         let mut history: Vec<(f64, f64)> = Vec::new();
         for _ in 0..max_outer {
-            let merit = Merit {
-                problem: self.problem,
+            let merit = Merit::new(
+                self.problem,
                 robust,
+                self.transform,
+                &self.lambda,
+                self.mu,
                 n,
-                transform: self.transform,
-                lambda: &self.lambda,
-                mu: self.mu,
-                cache: RefCell::new((Vec::new(), 0.0, Vec::new())),
-                x: RefCell::new(Vec::new()),
-                slope: RefCell::new(Vec::new()),
-                work: RefCell::new(Evaluation::new(n, m)),
-                evaluations: self.counter,
-            };
+                self.counter,
+            );
             let mut yz = self.y.clone();
             if let Some(r) = robust {
                 yz.extend(r.variables());
