@@ -36,6 +36,7 @@ pub struct CompiledFn {
     n_outputs: usize,
     n_instructions: usize,
     n_calls: usize,
+    n_spilled: usize,
 }
 
 // SAFETY: after `finalize_definitions` the module is never mutated again; the only thing
@@ -54,6 +55,7 @@ impl std::fmt::Debug for CompiledFn {
             .field("n_outputs", &self.n_outputs)
             .field("n_instructions", &self.n_instructions)
             .field("n_calls", &self.n_calls)
+            .field("n_spilled", &self.n_spilled)
             .finish()
     }
 }
@@ -149,6 +151,7 @@ impl CompiledFn {
                     n_outputs: outputs.len(),
                     n_instructions: built.n_instructions,
                     n_calls: built.n_calls,
+                    n_spilled: built.n_spilled,
                 })
             }
             Err(e) => {
@@ -179,6 +182,11 @@ impl CompiledFn {
     /// the cold-path calls).
     pub fn n_calls(&self) -> usize {
         self.n_calls
+    }
+    /// Number of values the generated code stores once and reloads (those used far from
+    /// their definition, such as the forward values the gradients re-read).
+    pub fn n_spilled(&self) -> usize {
+        self.n_spilled
     }
 
     /// Evaluate into `out` after checking every length.
@@ -288,6 +296,54 @@ mod tests {
                         a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()),
                         "({p}, {q}) output {k}, backend {j}: {a} vs {b}"
                     );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn values_used_far_away_are_reloaded_with_the_same_bits() {
+        // A long chain between the first uses of x, y, a and their last ones (as the
+        // gradients re-read forward values): those are stored once and reloaded.
+        let ctx = Ctx::new();
+        let (x, y) = (ctx.var(0), ctx.var(1));
+        let a = x.clone() * y.clone() + x.sin();
+        let mut c = a.clone();
+        for k in 0..200 {
+            c = if k % 3 == 0 {
+                c.clone() * 0.999 + y.clone()
+            } else {
+                (c.clone() * 0.5).cos() - c * 0.25
+            };
+        }
+        let outs = [
+            c.clone() * a.clone() + x.clone(),
+            c / (y.clone() + 3.0) - a.atan2(&x),
+        ];
+        let ids: Vec<_> = outs.iter().map(|s| ctx.node_id(s)).collect();
+        let g = ctx.to_graph();
+        let tape = Tape::new(&g, &ids, 2, 0).unwrap();
+        for math in [Math::Batch, Math::Inline] {
+            for opt in [OptLevel::Speed, OptLevel::None] {
+                let jit = CompiledFn::with_options(&g, &ids, 2, 0, opt, math).unwrap();
+                assert!(
+                    jit.n_spilled() >= 3,
+                    "{math:?} {opt:?}: {}",
+                    jit.n_spilled()
+                );
+                for &(p, q) in &[(0.3, -1.2), (2.5, 0.75), (-40.0, 1e-3), (0.0, -0.0)] {
+                    let (mut r, mut want) = ([0.0; 2], [0.0; 2]);
+                    jit.call(&[p, q], &[], &mut r).unwrap();
+                    tape.eval(&[p, q], &[], &mut want).unwrap();
+                    for k in 0..2 {
+                        assert!(
+                            r[k].to_bits() == want[k].to_bits()
+                                || (r[k].is_nan() && want[k].is_nan()),
+                            "{math:?} {opt:?} ({p}, {q}) output {k}: {} vs {}",
+                            r[k],
+                            want[k]
+                        );
+                    }
                 }
             }
         }
