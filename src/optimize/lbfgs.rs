@@ -233,16 +233,20 @@ fn more_thuente(
     }
 }
 
-/// The largest of three numbers, none NaN, as `Iterator::max_by` picks it (the last of
-/// equals).
-fn max3(v: [f64; 3]) -> f64 {
+/// The scale of `cstep`'s cubic, the largest of `θ` and the two slopes as argmin takes it
+/// (`Iterator::max_by`: the last of equals; not the largest magnitude, as in MINPACK);
+/// `None` where one is NaN or infinite (argmin's error).
+fn scale(v: [f64; 3]) -> Option<f64> {
+    if v.iter().any(|n| n.is_nan() || n.is_infinite()) {
+        return None;
+    }
     let mut s = v[0];
     for &x in &v[1..] {
         if s <= x {
             s = x;
         }
     }
-    s
+    Some(s)
 }
 
 /// One safeguarded step of the Moré–Thuente interval update (MINPACK's `dcstep` as argmin
@@ -267,17 +271,12 @@ fn cstep(
     {
         return Some((stx, sty, stp, brackt, info));
     }
-    let bad = |v: &[f64; 3]| v.iter().any(|n| n.is_nan() || n.is_infinite());
     let sgnd = stp.gx * (stx.gx / stx.gx.abs());
     if stp.fx > stx.fx {
         info = 1;
         bound = true;
         let theta = 3.0 * (stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx + stp.gx;
-        let tmp = [theta, stx.gx, stp.gx];
-        if bad(&tmp) {
-            return None;
-        }
-        let s = max3(tmp);
+        let s = scale([theta, stx.gx, stp.gx])?;
         let mut gamma = s * ((theta / s).powi(2) - (stx.gx / s) * (stp.gx / s)).sqrt();
         if stp.x < stx.x {
             gamma = -gamma;
@@ -298,11 +297,7 @@ fn cstep(
         info = 2;
         bound = false;
         let theta = 3.0 * (stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx + stp.gx;
-        let tmp = [theta, stx.gx, stp.gx];
-        if bad(&tmp) {
-            return None;
-        }
-        let s = max3(tmp);
+        let s = scale([theta, stx.gx, stp.gx])?;
         let mut gamma = s * ((theta / s).powi(2) - (stx.gx / s) * (stp.gx / s)).sqrt();
         if stp.x > stx.x {
             gamma = -gamma;
@@ -322,11 +317,7 @@ fn cstep(
         info = 3;
         bound = true;
         let theta = 3.0 * (stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx + stp.gx;
-        let tmp = [theta, stx.gx, stp.gx];
-        if bad(&tmp) {
-            return None;
-        }
-        let s = max3(tmp);
+        let s = scale([theta, stx.gx, stp.gx])?;
         let mut gamma = s * 0.0f64
             .max((theta / s).powi(2) - (stx.gx / s) * (stp.gx / s))
             .sqrt();
@@ -360,11 +351,7 @@ fn cstep(
         bound = false;
         if brackt {
             let theta = 3.0 * (stp.fx - sty.fx) / (sty.x - stp.x) + sty.gx + stp.gx;
-            let tmp = [theta, sty.gx, stp.gx];
-            if bad(&tmp) {
-                return None;
-            }
-            let s = max3(tmp);
+            let s = scale([theta, sty.gx, stp.gx])?;
             let mut gamma = s * ((theta / s).powi(2) - (sty.gx / s) * (stp.gx / s)).sqrt();
             if stp.x > sty.x {
                 gamma = -gamma;
