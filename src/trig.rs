@@ -1,6 +1,6 @@
 //! `sin`, `cos`, `atan2` and `acos`: one implementation for every backend.
 //!
-//! The kernels are written once over [`Ops`] and run as
+//! The kernels are written once over one trait of operations (`Ops`) and run as
 //! - `f64` ([`sin_cos`], [`sin`], [`cos`], [`atan2`], [`acos`]): what [`crate::kinematics`]
 //!   computes with for `f64` and what the expression interpreter and constant folding use;
 //! - four lanes of AVX2 (or that `f64` code in a loop without AVX2) in [`trig_batch`], which

@@ -37,7 +37,7 @@ pub struct NumericBenchArgs {
     /// A task file (.toml: a design of --graph is optimized first) or a design JSON
     /// (`OUT/designs/<id>.json` of `foldsynth synthesize`).
     pub target: PathBuf,
-    /// With a design JSON: its task file (default: grammar/<task>.toml, after the
+    /// With a design JSON: its task file (default: `grammar/<task>.toml`, after the
     /// design's "task").
     #[arg(long)]
     pub task: Option<PathBuf>,

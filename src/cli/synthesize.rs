@@ -14,7 +14,7 @@ use std::path::PathBuf;
 pub struct SynthesizeArgs {
     /// The task file (e.g. grammar/gripper.toml).
     pub task: PathBuf,
-    /// Output directory (default: out/<task name>). It must be new, empty, or an earlier
+    /// Output directory (default: `out/<task name>`). It must be new, empty, or an earlier
     /// run of the same settings (see --force).
     #[arg(long)]
     pub out: Option<PathBuf>,

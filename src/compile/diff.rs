@@ -3,7 +3,7 @@
 //! The adjoint of every node is accumulated in reverse topological order (decreasing node
 //! id) as new nodes of the same graph, so the gradient shares every forward node (the
 //! value+gradient cost is a small multiple of the value's). Only nodes that depend on a
-//! variable get adjoints. The local partials are [`super::jacobian`]'s (independent of
+//! variable get adjoints. The local partials are [`mod@super::jacobian`]'s (independent of
 //! the adjoint, so the sweep and the vertex elimination share them, and every quotient by
 //! `y` in them is a product with the one reciprocal `1/y`).
 //!

@@ -22,7 +22,7 @@
 //! assert!((buf[c.layout.gradient(0).start] - d).abs() < 1e-15);
 //! ```
 //!
-//! Stages: [`simplify`] (egg), [`diff`] (reverse mode) and [`jacobian`] (reverse sweeps or
+//! Stages: [`simplify`] (egg), [`diff`] (reverse mode) and [`mod@jacobian`] (reverse sweeps or
 //! vertex elimination), [`codegen`] (the Cranelift function
 //! builder) behind [`jit`] (in process) and [`aot`] (object, shared library, C header); [`dual`] is
 //! the forward-mode oracle the tests hold the differentiator to; [`vertex`] builds the

@@ -2,7 +2,7 @@
 //! numbers or symbols, precomputed once (dense indices, ray orders, how each sector and
 //! position is expressed, the order in which facets get their rigid maps).
 //!
-//! Evaluation ([`super::geometry`]) walks the plan generically over [`Scalar`].
+//! Evaluation ([`super::geometry`]) walks the plan generically over [`crate::kinematics::Scalar`].
 
 use crate::grammar::{ConstraintSpec, CreaseGraph, CreaseOrigin, VarKind, VertexType};
 use crate::kinematics::DriveExpr;

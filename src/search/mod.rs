@@ -1,7 +1,7 @@
 //! The search over design alternatives (thesis Fig. 39, Sec. 5.3–5.6): every meaningful
 //! graph × every gripping candidate × every assignment of rigid body modes.
 //!
-//! The work goes by unit ([`plan`]): one (graph, candidate) is one model, compiled once
+//! The work goes by unit ([`mod@plan`]): one (graph, candidate) is one model, compiled once
 //! when a worker takes the unit up and dropped after its last alternative; the 2^N mode
 //! assignments are parameters of that one native function. Each alternative is
 //! optimized; when it meets the target it is checked for self-intersection (both arms for
