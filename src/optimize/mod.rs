@@ -299,7 +299,7 @@ struct Merit<'a, P: Problem> {
 }
 
 impl<'a, P: Problem> Merit<'a, P> {
-    #[allow(clippy::too_many_arguments)]
+    /// The merit of one subproblem (`lambda`, `mu`), with fresh buffers and cache.
     fn new(
         problem: &'a P,
         robust: Option<&'a dyn Robust>,
