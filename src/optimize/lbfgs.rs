@@ -47,7 +47,7 @@ pub(super) fn minimize(f: &mut impl Smooth, y0: &[f64], s: &Settings) -> Vec<f64
     let mut best_cost = cost;
     let mut pairs: VecDeque<(Vec<f64>, Vec<f64>)> = VecDeque::with_capacity(s.memory);
     let (mut q, mut d) = (vec![0.0; n], vec![0.0; n]);
-    let (mut alpha, mut rho) = (vec![0.0; s.memory], vec![0.0; s.memory]);
+    let (mut alpha, mut rho) = (vec![0.0; s.memory + 1], vec![0.0; s.memory + 1]);
     let (mut x1, mut g1) = (vec![0.0; n], vec![0.0; n]);
     let mut iter = 0u64;
     loop {
@@ -88,11 +88,14 @@ pub(super) fn minimize(f: &mut impl Smooth, y0: &[f64], s: &Settings) -> Vec<f64
             // Not a descent direction, or the line search met a NaN: argmin stops here.
             break;
         };
-        let (mut sk, mut yk) = if pairs.len() == s.memory {
-            pairs.pop_front().expect("memory is full")
+        // The oldest pair's buffers are reused once the memory is full (argmin: from
+        // iteration `memory` on, which keeps one pair even at memory 0).
+        let recycled = if pairs.len() >= s.memory {
+            pairs.pop_front()
         } else {
-            (vec![0.0; n], vec![0.0; n])
+            None
         };
+        let (mut sk, mut yk) = recycled.unwrap_or_else(|| (vec![0.0; n], vec![0.0; n]));
         for j in 0..n {
             sk[j] = x1[j] - param[j];
             yk[j] = g1[j] - grad[j];
@@ -559,6 +562,27 @@ mod tests {
         let ((best, _), _) = both_runs(rosenbrock, &[-1.2, 1.0, -0.5, 0.8, 1.5], &s);
         for b in best {
             assert!((b - 1.0).abs() < 1e-6, "{b}");
+        }
+    }
+
+    #[test]
+    fn same_iterates_as_argmin_at_other_memories() {
+        for memory in [0, 1, 3] {
+            let s = Settings {
+                memory,
+                max_iters: 60,
+                tol_grad: 1e-10,
+                tol_cost: 1e-14,
+            };
+            let ((best, log), (their_best, their_log)) =
+                both_runs(rosenbrock, &[-1.2, 1.0, -0.5], &s);
+            assert!(
+                log.len() >= 10,
+                "memory {memory}: {} evaluations",
+                log.len()
+            );
+            assert_eq!(log, their_log, "memory {memory}");
+            assert_eq!(best, their_best, "memory {memory}");
         }
     }
 
