@@ -398,7 +398,9 @@ pub(crate) fn define_eval<M: Module>(
         // positions reload them: their SSA values stay short-lived, so the register
         // allocator has no long live ranges to split (the arm's models compile in 40 %
         // less time, and run as fast). Stores and loads move the bits unchanged.
+        // Positions in the emission order: each emitted node, then each depth's batch.
         let mut pos = vec![usize::MAX; nodes.len()];
+        let mut batch_pos = vec![usize::MAX; order.len()];
         let mut last_use = vec![0usize; nodes.len()];
         let mut n_pos = 0usize;
         for (d, phase) in order.iter().enumerate() {
@@ -407,20 +409,19 @@ pub(crate) fn define_eval<M: Module>(
                     continue;
                 }
                 pos[i] = n_pos;
+                let mut read = |r: NodeId| last_use[r.index()] = last_use[r.index()].max(n_pos);
                 for c in nodes[i].children() {
-                    // A fused product's factors are read by its user.
-                    let reads: Vec<NodeId> = if fused[c.index()] {
-                        nodes[c.index()].children().into_iter().collect()
+                    if fused[c.index()] {
+                        // A fused product's factors are read by its user.
+                        nodes[c.index()].children().into_iter().for_each(&mut read);
                     } else {
-                        vec![c]
-                    };
-                    for r in reads {
-                        last_use[r.index()] = last_use[r.index()].max(n_pos);
+                        read(c);
                     }
                 }
                 n_pos += 1;
             }
             if let Some(bt) = batches.get(d) {
+                batch_pos[d] = n_pos;
                 let args = bt.sc.iter().copied().chain(
                     bt.at
                         .iter()
@@ -478,7 +479,6 @@ pub(crate) fn define_eval<M: Module>(
             }
         };
 
-        let mut at_pos = 0usize;
         for (d, phase) in order.iter().enumerate() {
             for &i in phase {
                 if fused[i] {
@@ -486,6 +486,7 @@ pub(crate) fn define_eval<M: Module>(
                     continue;
                 }
                 let node = nodes[i];
+                let at_pos = pos[i];
                 let mut o = [None; 3];
                 // (operand position, factors) of a product fused into this sum.
                 let mut fma: Option<(usize, Value, Value)> = None;
@@ -575,13 +576,12 @@ pub(crate) fn define_eval<M: Module>(
                     b.ins().stack_store(ptr, x, slot, 8 * spill_off[i] as i32);
                     Source::Spilled(x, at_pos, spill_off[i])
                 };
-                at_pos += 1;
             }
             let Some(bt) = batches.get(d) else { continue };
             if bt.len() == 0 {
-                at_pos += 1;
                 continue;
             }
+            let at_pos = batch_pos[d];
             // The batch: store the arguments, one call, results stay in the slot.
             let slot = slot.expect("a slot exists");
             let (nsc, nat, nac) = (bt.sc.len(), bt.at.len(), bt.ac.len());
@@ -606,7 +606,6 @@ pub(crate) fn define_eval<M: Module>(
             let addr = b.ins().stack_addr(ptr, slot, at(0));
             let n = [nsc, nat, nac].map(|n| b.ins().iconst(ptr, n as i64));
             b.ins().call(f, &[addr, n[0], n[1], n[2]]);
-            at_pos += 1;
             n_calls += 1;
             n_inst += 1;
             let out0 = bt.base + (nsc + 2 * nat + nac) as u32;

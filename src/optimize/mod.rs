@@ -339,7 +339,7 @@ impl<P: Problem> lbfgs::Smooth for Merit<'_, P> {
         let e = &mut self.work;
         self.problem.eval(&self.x, e);
         self.evaluations.set(self.evaluations.get() + 1);
-        let n = self.x.len();
+        let n = self.n;
         let mut value = e.f;
         grad[..n].copy_from_slice(&e.df);
         grad[n..].iter_mut().for_each(|g| *g = 0.0);
