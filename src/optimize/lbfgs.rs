@@ -28,6 +28,12 @@ pub(super) struct Settings {
     pub tol_grad: f64,
     /// Stop when an iteration changes the value by less than this (absolute).
     pub tol_cost: f64,
+    /// Stop when the last `stall_window` iterations together lowered the value by less
+    /// than [`Settings::stall_tol`]: a run creeping along a kink or a bound (issue 14).
+    /// 0: no such test, as in argmin; the iterates up to the stop are the same either way.
+    pub stall_window: usize,
+    /// See [`Settings::stall_window`] (absolute, like `tol_cost`).
+    pub stall_tol: f64,
 }
 
 /// `Σ a_i b_i`, summed in order as argmin-math sums.
@@ -50,7 +56,16 @@ pub(super) fn minimize(f: &mut impl Smooth, y0: &[f64], s: &Settings) -> Vec<f64
     let (mut alpha, mut rho) = (vec![0.0; s.memory + 1], vec![0.0; s.memory + 1]);
     let (mut x1, mut g1) = (vec![0.0; n], vec![0.0; n]);
     let mut iter = 0u64;
+    // The values at the last `stall_window + 1` iterates, a ring indexed by iteration.
+    let mut recent = vec![0.0; s.stall_window + 1];
     loop {
+        if s.stall_window > 0 {
+            let (k, len) = (iter as usize, recent.len());
+            recent[k % len] = cost;
+            if k >= s.stall_window && recent[(k + 1) % len] - cost < s.stall_tol {
+                break;
+            }
+        }
         // argmin's termination order: the solver's tests, then the iteration cap.
         let norm = grad.iter().map(|a| a.powi(2)).sum::<f64>().sqrt();
         if norm < s.tol_grad || (prev_cost - cost).abs() < s.tol_cost || iter >= s.max_iters {
@@ -533,6 +548,8 @@ mod tests {
             max_iters: 150,
             tol_grad: 1e-10,
             tol_cost: 1e-14,
+            stall_window: 0,
+            stall_tol: 0.0,
         };
         type TestFn = fn(&[f64], &mut [f64]) -> f64;
         let cases: [(&[f64], TestFn); 7] = [
@@ -573,6 +590,8 @@ mod tests {
                 max_iters: 60,
                 tol_grad: 1e-10,
                 tol_cost: 1e-14,
+                stall_window: 0,
+                stall_tol: 0.0,
             };
             let ((best, log), (their_best, their_log)) =
                 both_runs(rosenbrock, &[-1.2, 1.0, -0.5], &s);
@@ -586,6 +605,53 @@ mod tests {
         }
     }
 
+    /// The stall test only cuts a run short: the points it evaluates are the first ones of
+    /// the run without it; where the merit creeps (the kinked sum of distances) it stops
+    /// early, and where progress is steady (Rosenbrock) it still reaches the minimum.
+    #[test]
+    fn the_stall_test_only_truncates_a_creeping_run() {
+        let full = Settings {
+            memory: 8,
+            max_iters: 150,
+            tol_grad: 1e-10,
+            tol_cost: 0.0,
+            stall_window: 0,
+            stall_tol: 0.0,
+        };
+        let cut = Settings {
+            stall_window: 10,
+            stall_tol: 1e-8,
+            ..full
+        };
+        type TestFn = fn(&[f64], &mut [f64]) -> f64;
+        // (start, function, whether its progress is steady to the minimum)
+        let cases: [(&[f64], TestFn, bool); 3] = [
+            (&[0.4, -1.3, 2.2], kinked, false),
+            (&[1.5, 1.5, -0.2], kinked, false),
+            (&[-1.2, 1.0, -0.5, 0.8, 1.5], rosenbrock, true),
+        ];
+        let mut shortened = 0;
+        for (y0, f, steady) in cases {
+            let (a, b) = (Recorded::new(f), Recorded::new(f));
+            minimize(&mut &a, y0, &full);
+            let best = minimize(&mut &b, y0, &cut);
+            let (a, b) = (a.log.into_inner(), b.log.into_inner());
+            assert!(b.len() <= a.len(), "from {y0:?}");
+            assert_eq!(
+                b[..],
+                a[..b.len()],
+                "from {y0:?}: not the same first points"
+            );
+            shortened += usize::from(b.len() < a.len());
+            if steady {
+                for x in best {
+                    assert!((x - 1.0).abs() < 1e-6, "{x}: stopped short of the minimum");
+                }
+            }
+        }
+        assert!(shortened >= 2, "the kinked runs were not cut short");
+    }
+
     #[test]
     fn stops_at_the_iteration_cap_and_keeps_the_best_point() {
         let s = Settings {
@@ -593,6 +659,8 @@ mod tests {
             max_iters: 3,
             tol_grad: 0.0,
             tol_cost: 0.0,
+            stall_window: 0,
+            stall_tol: 0.0,
         };
         let f = Recorded::new(rosenbrock);
         let y0 = [-1.2, 1.0];
