@@ -108,16 +108,14 @@ impl CompiledModel {
     /// Copy one evaluation from the output buffer into an optimizer [`Evaluation`].
     pub fn unpack(&self, buf: &[f64], e: &mut Evaluation) {
         let l = &self.compiled.layout;
+        let m = self.n_constraints;
         e.f = buf[l.value(0)];
+        e.g.copy_from_slice(&buf[l.value(1)..l.value(1) + m]);
         if l.gradients {
             e.df.copy_from_slice(&buf[l.gradient(0)]);
-        }
-        for k in 0..self.n_constraints {
-            e.g[k] = buf[l.value(k + 1)];
-            if l.gradients {
-                let n = self.n_vars;
-                e.dg[k * n..(k + 1) * n].copy_from_slice(&buf[l.gradient(k + 1)]);
-            }
+            // The constraints' gradients are consecutive rows: the Jacobian in one copy.
+            let rows = l.gradient(1).start..l.gradient(1).start + m * self.n_vars;
+            e.dg.copy_from_slice(&buf[rows]);
         }
     }
 }

@@ -60,8 +60,9 @@ use crate::geom::V3;
 use crate::kinematics::{Scalar, wrap_angle};
 use crate::optimize::{Acceptance, Robust};
 use crate::task::{Cylinder, Robustness, Task};
-use std::cell::RefCell;
+use std::cell::{Cell, OnceCell, RefCell};
 use std::f64::consts::PI;
+use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 
 /// Relative safety over each setting at the sampled states (half of it on the sweep).
@@ -1096,5 +1097,127 @@ impl Robust for RobustProblem<'_> {
         } else {
             Acceptance::Refined
         }
+    }
+}
+
+/// A model's robustness block, compiled when an alternative first needs it (issue 14): only
+/// an alternative whose phase A meets the target does, and most models have none (the
+/// robotic arm: 45 of its 159 models), so compiling every block up front spent most of the
+/// block's compile time on code that never ran.
+pub struct LazyBlock {
+    spec: RobustSpec,
+    block: OnceLock<Result<RobustModel, String>>,
+    /// CPU seconds its compilation took (0 until it ran).
+    compile_s: Mutex<f64>,
+}
+
+impl LazyBlock {
+    /// Not compiled yet.
+    pub fn new(spec: RobustSpec) -> LazyBlock {
+        LazyBlock {
+            spec,
+            block: OnceLock::new(),
+            compile_s: Mutex::new(0.0),
+        }
+    }
+
+    /// The block of `model` (the model this block belongs to), compiled by the first call
+    /// from any thread; with the CPU seconds this call spent compiling it (0 unless it was
+    /// the first).
+    pub fn get(&self, model: &Model) -> (Result<&RobustModel, &str>, f64) {
+        let mut spent = 0.0;
+        let block = self.block.get_or_init(|| {
+            let t = crate::cpu_time::Stopwatch::start();
+            let block = RobustModel::new(model, self.spec.clone()).map_err(|e| e.to_string());
+            spent = t.cpu_ms() / 1e3;
+            *self.compile_s.lock().unwrap_or_else(|e| e.into_inner()) = spent;
+            block
+        });
+        (block.as_ref().map_err(String::as_str), spent)
+    }
+
+    /// Whether an alternative has needed it (and it was compiled, or failed to).
+    pub fn is_compiled(&self) -> bool {
+        self.block.get().is_some()
+    }
+
+    /// CPU seconds its compilation took (0 if it has not been compiled).
+    pub fn compile_s(&self) -> f64 {
+        *self.compile_s.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// The [`Robust`] of one alternative on a [`LazyBlock`]: the block is compiled, and the
+/// alternative's [`RobustProblem`] built, on the first call of any method — the same
+/// problem, so the same results, as one built up front. Should the block fail to compile,
+/// it holds nowhere (the optimizer gives up on it) and [`Deferred::error`] says why.
+pub struct Deferred<'a> {
+    model: &'a Model,
+    lazy: &'a LazyBlock,
+    modes: Vec<f64>,
+    problem: OnceCell<Result<RobustProblem<'a>, String>>,
+    compile_s: Cell<f64>,
+}
+
+impl<'a> Deferred<'a> {
+    /// The block of `model` with the given modes, not built yet.
+    pub fn new(model: &'a Model, lazy: &'a LazyBlock, modes: &[f64]) -> Deferred<'a> {
+        Deferred {
+            model,
+            lazy,
+            modes: modes.to_vec(),
+            problem: OnceCell::new(),
+            compile_s: Cell::new(0.0),
+        }
+    }
+
+    fn get(&self) -> Option<&RobustProblem<'a>> {
+        self.problem
+            .get_or_init(|| {
+                let (block, spent) = self.lazy.get(self.model);
+                self.compile_s.set(spent);
+                block
+                    .map(|b| RobustProblem::new(self.model, b, &self.modes))
+                    .map_err(str::to_string)
+            })
+            .as_ref()
+            .ok()
+    }
+
+    /// Why the block could not be compiled, if it was needed and could not.
+    pub fn error(&self) -> Option<&str> {
+        self.problem.get()?.as_ref().err().map(String::as_str)
+    }
+
+    /// CPU seconds this alternative spent compiling the block (0 unless it was the first to
+    /// need it).
+    pub fn compile_s(&self) -> f64 {
+        self.compile_s.get()
+    }
+}
+
+impl Robust for Deferred<'_> {
+    fn reset(&self) {
+        if let Some(p) = self.get() {
+            p.reset();
+        }
+    }
+    fn update(&self, x: &[f64], mu: Option<f64>) -> f64 {
+        self.get().map_or(f64::INFINITY, |p| p.update(x, mu))
+    }
+    fn variables(&self) -> Vec<f64> {
+        self.get().map_or_else(Vec::new, |p| p.variables())
+    }
+    fn set_variables(&self, z: &[f64]) {
+        if let Some(p) = self.get() {
+            p.set_variables(z);
+        }
+    }
+    fn merit(&self, x: &[f64], z: &[f64], mu: f64, grad_x: &mut [f64], grad_z: &mut [f64]) -> f64 {
+        self.get()
+            .map_or(0.0, |p| p.merit(x, z, mu, grad_x, grad_z))
+    }
+    fn accept(&self, x: &[f64]) -> Acceptance {
+        self.get().map_or(Acceptance::Rejected, |p| p.accept(x))
     }
 }

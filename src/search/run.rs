@@ -15,7 +15,7 @@ use crate::grammar::{CreaseGraph, Rules};
 use crate::limits;
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use crate::model::numeric::{Evaluated, sample_times};
-use crate::model::robust::{RobustModel, RobustProblem, RobustSpec};
+use crate::model::robust::{Deferred, LazyBlock, RobustSpec};
 use crate::model::{Model, ModelError};
 use crate::optimize::{self, SharedStarts, minimize_shared};
 use crate::pattern::Pattern;
@@ -170,12 +170,13 @@ pub struct Prepared {
     pub model: Model,
     /// Its native code.
     pub compiled: CompiledModel,
-    /// Its robustness block (absent with `--post-check-only`).
-    pub robust: Option<RobustModel>,
+    /// Its robustness block (absent with `--post-check-only`), compiled when an
+    /// alternative first needs it.
+    pub robust: Option<LazyBlock>,
 }
 
 /// Build and compile the model of one graph and candidate, with its robustness block
-/// when `robust` is given.
+/// (compiled on first use) when `robust` is given.
 pub fn prepare(
     graph: &CreaseGraph,
     task: &Task,
@@ -185,10 +186,7 @@ pub fn prepare(
     let model = Model::new(graph, task, candidate).map_err(|e| e.to_string())?;
     let compiled =
         CompiledModel::new(&model, &CompileOptions::default()).map_err(|e| e.to_string())?;
-    let robust = robust
-        .map(|spec| RobustModel::new(&model, spec.clone()))
-        .transpose()
-        .map_err(|e| e.to_string())?;
+    let robust = robust.map(|spec| LazyBlock::new(spec.clone()));
     Ok(Prepared {
         model,
         compiled,
@@ -237,7 +235,8 @@ enum CheckFailure {
 
 /// Optimize, check and verify one alternative; `shared`: the phase-A starts of its class
 /// (the alternatives of its model whose modes differ only where no output depends on
-/// them), whose seed it optimizes with.
+/// them), whose seed it optimizes with. An error when the model's robustness block was
+/// needed and could not be compiled.
 fn evaluate(
     task: &Task,
     p: &Prepared,
@@ -245,7 +244,7 @@ fn evaluate(
     graph: &CreaseGraph,
     opts: &SearchOptions,
     shared: &SharedStarts,
-) -> AlternativeRecord {
+) -> Result<AlternativeRecord, String> {
     let model = &p.model;
     let modes = alt.mode_signs();
     let key = alt.key();
@@ -262,11 +261,19 @@ fn evaluate(
         },
         ..Default::default()
     };
+    // CPU seconds this alternative spent compiling the model's robustness block: compile
+    // time, not optimization.
+    let mut block_compile_s = 0.0;
     let mut sol = match &p.robust {
         None => minimize_shared(&problem, None, &optimize_opts, Some(shared)),
-        Some(block) => {
-            let rp = RobustProblem::new(model, block, &modes);
-            minimize_shared(&problem, Some(&rp), &optimize_opts, Some(shared))
+        Some(lazy) => {
+            let rp = Deferred::new(model, lazy, &modes);
+            let sol = minimize_shared(&problem, Some(&rp), &optimize_opts, Some(shared));
+            if let Some(e) = rp.error() {
+                return Err(e.to_string());
+            }
+            block_compile_s = rp.compile_s();
+            sol
         }
     };
     // Cyclic patterns: Newton on the compatibility equations, to rounding.
@@ -278,7 +285,7 @@ fn evaluate(
         optimize_opts.feasibility_tol,
         optimize_opts.target,
     );
-    let optimize_ms = t0.cpu_ms();
+    let optimize_ms = t0.cpu_ms() - block_compile_s * 1e3;
     let full = model.full_vars(&sol.x);
     let omega = model.omega(&full, &modes);
     let meets = sol.feasible && omega <= model.threshold;
@@ -321,7 +328,7 @@ fn evaluate(
         cycle: None,
     };
     if !meets {
-        return rec;
+        return Ok(rec);
     }
     let t1 = Stopwatch::start();
     let design = Evaluated::new(&model.plan, full, modes);
@@ -428,7 +435,7 @@ fn evaluate(
         rec.short_of_margins = rec.margins_short();
     }
     rec.check_ms = t1.cpu_ms();
-    rec
+    Ok(rec)
 }
 
 /// The robustness of a design measured by `check::robustness` on the checked pattern
@@ -559,7 +566,9 @@ pub struct Share<'a> {
     pub task_text: &'a str,
 }
 
-/// A model that could not be built or compiled: its alternatives have no records.
+/// A model that could not be built or compiled: its alternatives have no records (when
+/// only its robustness block fails, which shows when an alternative first needs it, those
+/// that never needed it keep theirs).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct FailedModel {
     /// The graph's rule sequence.
@@ -601,7 +610,7 @@ pub struct ShardReport {
     pub cost: u64,
     /// Estimated cost of the whole search.
     pub total_cost: u64,
-    /// Models that failed (their alternatives have no records).
+    /// Models that failed (see [`FailedModel`] for which alternatives have no records).
     pub failed_models: Vec<FailedModel>,
     /// Time per stage; `total_s` is this run's wall time.
     pub timings: Timings,
@@ -877,7 +886,29 @@ pub fn evaluate_units(
                 let shared = SharedStarts::new(alternative_seed(opts.seed, &key));
                 for &m in members {
                     let alt = plan.alternative(u, m);
-                    let rec = evaluate(task, &prepared, &alt, &graph, opts, &shared);
+                    let rec = match evaluate(task, &prepared, &alt, &graph, opts, &shared) {
+                        Ok(rec) => rec,
+                        Err(error) => {
+                            // Every alternative that needs the block gets the same error:
+                            // the model is reported once.
+                            let mut failed = failed.lock().unwrap_or_else(|e| e.into_inner());
+                            let sequence = &plan.graphs[unit.graph].sequence;
+                            let candidate = unit.candidate + 1;
+                            if !failed
+                                .iter()
+                                .any(|f| &f.sequence == sequence && f.candidate == candidate)
+                            {
+                                eprintln!("error: {sequence} (candidate {candidate}): {error}");
+                                failed.push(FailedModel {
+                                    sequence: sequence.clone(),
+                                    candidate,
+                                    error,
+                                });
+                            }
+                            progress.inc(1);
+                            continue;
+                        }
+                    };
                     let mut line = serde_json::to_string(&rec).unwrap_or_default();
                     line.push('\n');
                     if let Ok(mut w) = writer.lock() {
@@ -891,6 +922,9 @@ pub fn evaluate_units(
                     progress.inc(1);
                 }
             });
+            if let Some(block) = &prepared.robust {
+                *compile_s.lock().unwrap_or_else(|e| e.into_inner()) += block.compile_s();
+            }
             // `prepared` (the native code) is dropped here, with its last alternative.
         });
     });
