@@ -1101,9 +1101,9 @@ impl Robust for RobustProblem<'_> {
 }
 
 /// A model's robustness block, compiled when an alternative first needs it (issue 14): only
-/// an alternative whose phase A meets the target does, and most models have none (the
-/// robotic arm: 45 of its 159 models), so compiling every block up front spent most of the
-/// block's compile time on code that never ran.
+/// an alternative whose phase A meets the target does, and most models have none (only 45
+/// of the robotic arm's 159 models need theirs), so compiling every block up front spent
+/// most of the blocks' compile time on code that never ran.
 pub struct LazyBlock {
     spec: RobustSpec,
     block: OnceLock<Result<RobustModel, String>>,
