@@ -5,8 +5,8 @@
 //! seed, sweep and foldsynth version), every shard 1 … N given once, each shard's task
 //! file the one its settings name, and each shard complete — every alternative of its
 //! units on record exactly once (the alternatives of a model its `shard.json` lists as
-//! failed excepted: a single run has no records for most of them either). An incomplete shard is
-//! named with the alternatives it lacks and the command that resumes it. Then the
+//! failed excepted: a single run has no records for most of them either). An incomplete
+//! shard is named with the alternatives it lacks and the command that resumes it. Then the
 //! records are copied into one `alternatives.jsonl` and summarized, and the designs,
 //! exports and report are written by the same code as a single run's.
 
