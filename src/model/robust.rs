@@ -62,7 +62,7 @@ use crate::optimize::{Acceptance, Robust};
 use crate::task::{Cylinder, Robustness, Task};
 use std::cell::{Cell, OnceCell, RefCell};
 use std::f64::consts::PI;
-use std::sync::{Mutex, OnceLock};
+use std::sync::OnceLock;
 use std::time::Instant;
 
 /// Relative safety over each setting at the sampled states (half of it on the sweep).
@@ -1106,9 +1106,8 @@ impl Robust for RobustProblem<'_> {
 /// most of the blocks' compile time on code that never ran.
 pub struct LazyBlock {
     spec: RobustSpec,
-    block: OnceLock<Result<RobustModel, String>>,
-    /// CPU seconds its compilation took (0 until it ran).
-    compile_s: Mutex<f64>,
+    /// The block (or why it failed) and the CPU seconds its compilation took.
+    block: OnceLock<(Result<RobustModel, String>, f64)>,
 }
 
 impl LazyBlock {
@@ -1117,7 +1116,6 @@ impl LazyBlock {
         LazyBlock {
             spec,
             block: OnceLock::new(),
-            compile_s: Mutex::new(0.0),
         }
     }
 
@@ -1125,14 +1123,14 @@ impl LazyBlock {
     /// from any thread; with the CPU seconds this call spent compiling it (0 unless it was
     /// the first).
     pub fn get(&self, model: &Model) -> (Result<&RobustModel, &str>, f64) {
-        let mut spent = 0.0;
-        let block = self.block.get_or_init(|| {
+        let mut first = false;
+        let (block, s) = self.block.get_or_init(|| {
+            first = true;
             let t = crate::cpu_time::Stopwatch::start();
             let block = RobustModel::new(model, self.spec.clone()).map_err(|e| e.to_string());
-            spent = t.cpu_ms() / 1e3;
-            *self.compile_s.lock().unwrap_or_else(|e| e.into_inner()) = spent;
-            block
+            (block, t.cpu_ms() / 1e3)
         });
+        let spent = if first { *s } else { 0.0 };
         (block.as_ref().map_err(String::as_str), spent)
     }
 
@@ -1143,7 +1141,7 @@ impl LazyBlock {
 
     /// CPU seconds its compilation took (0 if it has not been compiled).
     pub fn compile_s(&self) -> f64 {
-        *self.compile_s.lock().unwrap_or_else(|e| e.into_inner())
+        self.block.get().map_or(0.0, |(_, s)| *s)
     }
 }
 
