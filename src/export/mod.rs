@@ -9,6 +9,8 @@
 //! - [`verify`]: the independent check behind `foldsynth verify`,
 //! - [`svg`]: the crease pattern in Origami Simulator's SVG convention,
 //! - [`render`]: folded states as PNG, SVG and animated GIF,
+//! - [`raster`]: the GIF's frames drawn straight into palette entries,
+//! - [`lzw`]: the GIF frames' LZW compression, with a fast path for runs,
 //! - [`mesh`]: OBJ and STL of a folded state,
 //! - [`plots`]: the search tree (thesis Fig. 48) and the distribution of designs (Fig. 51),
 //! - [`report`]: the self-contained, interactive `report.html` (three.js inlined),
@@ -24,8 +26,10 @@
 //! ```
 
 pub mod fold;
+pub mod lzw;
 pub mod mesh;
 pub mod plots;
+pub mod raster;
 pub mod render;
 pub mod report;
 pub mod samples;
