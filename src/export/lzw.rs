@@ -181,12 +181,18 @@ impl Encoder<'_> {
         let mut code = u16::from(first);
         let mut sym = first;
         let mut run: Option<usize> = Some(1);
+        // Where the run of `sym` that position i is in ends: measured once per run, not
+        // once per step along it (that made a run of length L cost L^1.5).
+        let mut run_end = 0;
         let mut i = 1;
         while i < data.len() {
             let b = data[i];
             if let (Some(k), true) = (run, b == sym) {
                 let s = usize::from(sym);
-                let len = run_length(&data[i..], sym);
+                if i >= run_end || data[run_end - 1] != sym {
+                    run_end = i + run_length(&data[i..], sym);
+                }
+                let len = run_end - i;
                 let have = usize::from(self.t.run_len[s]);
                 if k + len <= have {
                     // The whole run extends the string within the dictionary.

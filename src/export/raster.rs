@@ -81,8 +81,7 @@ impl<'p> Indexed<'p> {
                 (lo.min(p[1]), hi.max(p[1]))
             });
         // Rows whose centre y + ½ lies in [lo, hi).
-        let first = ((lo - 0.5).ceil().max(0.0)) as usize;
-        let last = ((hi - 0.5).ceil().min(self.h as f64)).max(0.0) as usize;
+        let (first, last) = (centre_index(lo, self.h), centre_index(hi, self.h));
         if first >= last {
             return;
         }
@@ -133,8 +132,10 @@ impl<'p> Indexed<'p> {
                     continue;
                 }
                 // Pixels whose centre x + ½ lies in [x0, x1).
-                let x0 = ((pair[0].0 - 0.5).ceil().max(0.0) as usize).min(self.w);
-                let x1 = ((pair[1].0 - 0.5).ceil().max(0.0) as usize).min(self.w);
+                let (x0, x1) = (
+                    centre_index(pair[0].0, self.w),
+                    centre_index(pair[1].0, self.w),
+                );
                 if x0 >= x1 {
                     continue;
                 }
@@ -214,11 +215,17 @@ impl<'p> Indexed<'p> {
         }
     }
 
-    /// One straight piece of a stroke: the rectangle `width` wide around `a`–`b`.
+    /// One straight piece of a stroke: the rectangle `width` wide around `a`–`b`, or for
+    /// an opaque stroke at most a pixel wide, a hairline.
     fn segment(&mut self, a: [f64; 2], b: [f64; 2], width: f64, color: Rgba) {
         let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
         let len = dx.hypot(dy);
         if len.is_nan() || len <= 0.0 {
+            return;
+        }
+        if width <= 1.0 && color[3] == 255 {
+            let e = self.palette.index(color[0], color[1], color[2]);
+            self.hairline(a, b, e);
             return;
         }
         let (nx, ny) = (-dy / len * width / 2.0, dx / len * width / 2.0);
@@ -231,6 +238,35 @@ impl<'p> Indexed<'p> {
             ],
             color,
         );
+    }
+
+    /// One pixel per column (per row, for a steep line) whose centre lies between the ends:
+    /// the pixel the line crosses that centre line in.
+    fn hairline(&mut self, a: [f64; 2], b: [f64; 2], entry: u8) {
+        // Along the major axis `m`, across it `c`; (w, h) in the same roles.
+        let steep = (b[1] - a[1]).abs() > (b[0] - a[0]).abs();
+        let (m, c, along, across) = if steep {
+            (1, 0, self.h, self.w)
+        } else {
+            (0, 1, self.w, self.h)
+        };
+        let (p, q) = if a[m] <= b[m] { (a, b) } else { (b, a) };
+        let slope = (q[c] - p[c]) / (q[m] - p[m]);
+        for k in centre_index(p[m], along)..centre_index(q[m], along) {
+            let at = p[c] + (k as f64 + 0.5 - p[m]) * slope;
+            // The pixel containing `at` (floor, through i64: no libm call).
+            let t = at as i64;
+            let j = if (t as f64) > at { t - 1 } else { t };
+            if (0..across as i64).contains(&j) {
+                let j = j as usize;
+                let i = if steep {
+                    k * self.w + j
+                } else {
+                    j * self.w + k
+                };
+                self.px[i] = entry;
+            }
+        }
     }
 
     /// A disc of radius `r` around `c` in `fill` with a ring one pixel wide in `ring` on
@@ -247,6 +283,17 @@ impl<'p> Indexed<'p> {
         self.fill(&circle(r + 0.5), ring);
         self.fill(&circle(r - 0.5), fill);
     }
+}
+
+/// The first pixel whose centre k + ½ is at or past `v`, clamped to 0..=`n`: ⌈v − ½⌉
+/// without a call to libm's `ceil` (baseline x86-64 has no rounding instruction).
+#[inline]
+fn centre_index(v: f64, n: usize) -> usize {
+    // NaN and negatives go to 0; values past n to n.
+    // Through i64: one instruction each way, where usize's conversions take branches.
+    let x = (v - 0.5).max(0.0).min(n as f64);
+    let t = x as i64;
+    (if (t as f64) < x { t + 1 } else { t }) as usize
 }
 
 #[cfg(test)]
@@ -270,6 +317,17 @@ mod tests {
             }
         }
         w != 0
+    }
+
+    #[test]
+    fn centre_index_is_the_ceiling_of_v_minus_a_half_clamped() {
+        for v in [
+            -3.0, -0.2, 0.0, 0.49, 0.5, 0.51, 1.5, 2.25, 7.5, 9.99, 10.5, 11.0, 1e300,
+        ] {
+            let want = (v - 0.5f64).ceil().clamp(0.0, 10.0) as usize;
+            assert_eq!(centre_index(v, 10), want, "{v}");
+        }
+        assert_eq!(centre_index(f64::NAN, 10), 0);
     }
 
     #[test]
