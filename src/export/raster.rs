@@ -1,13 +1,13 @@
-//! Hard-edged drawing straight into GIF palette indices (issue 14).
+//! Hard-edged drawing straight into GIF palette entries (issue 14).
 //!
-//! The GIF's frames were drawn with tiny-skia into RGBA and then mapped pixel by pixel to
-//! the palette: two thirds of the export's drawing time for pictures the GIF shows without
-//! anti-aliasing anyway. Here a frame is a buffer of palette entries, and the only
-//! primitive is a polygon filled by the nonzero rule at pixel centres (a pixel is painted
-//! when its centre is inside). Strokes are thin polygons along their segments, so they
-//! follow the same rule. Opaque colours write their entry; translucent ones (the obstacle)
-//! go through a 256-entry table "entry under it → entry of the blend", computed once per
-//! colour.
+//! The GIF's frames were drawn anti-aliased with tiny-skia into RGBA and then mapped pixel
+//! by pixel to the palette. Here a frame is a buffer of palette entries ([`Indexed`]), and
+//! the primitive is a polygon filled by the nonzero rule at pixel centres (a pixel is
+//! painted when its centre is inside). Wide strokes are thin polygons along their segments;
+//! opaque strokes at most a pixel wide are hairlines, one pixel per column (per row when
+//! steep). Opaque colours write their entry; translucent ones (the obstacle) go through a
+//! 256-entry table "entry under it → entry of the blend", computed once per colour.
+//! [`Canvas`] is what `render` draws a scene on: this picture or tiny-skia's pixmap.
 
 use std::collections::HashMap;
 
@@ -41,6 +41,31 @@ struct Edge {
     dir: i32,
 }
 
+/// How a line is drawn: its colour, its width in pixels, and its dash lengths on and off.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pen {
+    /// The colour.
+    pub color: Rgba,
+    /// Width in pixels; an opaque pen at most 1 wide draws hairlines.
+    pub width: f64,
+    /// Lengths on and off, continued across corners; `None`: solid.
+    pub dash: Option<[f64; 2]>,
+}
+
+/// What a picture is drawn on, in pixel coordinates (y down): [`Indexed`] for the GIF's
+/// frames, tiny-skia's pixmap (anti-aliased) for the PNG pictures (`render`).
+pub trait Canvas {
+    /// Width and height in pixels.
+    fn size(&self) -> (u32, u32);
+    /// Fill the polygon `pts` (closed implicitly) by the nonzero winding rule.
+    fn fill(&mut self, pts: &[[f64; 2]], color: Rgba);
+    /// Stroke the polyline `pts` (closed when `close`) with butt ends.
+    fn stroke(&mut self, pts: &[[f64; 2]], close: bool, pen: Pen);
+    /// A disc of radius `r` around `c` in `fill` with a ring one pixel wide in `ring` on
+    /// its edge (as a stroke of width 1 on the circle would be).
+    fn dot(&mut self, c: [f64; 2], r: f64, fill: Rgba, ring: Rgba);
+}
+
 impl<'p> Indexed<'p> {
     /// A `w`×`h` picture filled with the entry of `background`.
     pub fn new(w: u32, h: u32, background: Rgba, palette: &'p GifPalette) -> Indexed<'p> {
@@ -64,14 +89,84 @@ impl<'p> Indexed<'p> {
         self.px.fill(e);
     }
 
-    /// Width and height.
-    pub fn size(&self) -> (usize, usize) {
-        (self.w, self.h)
+    /// The table of a translucent colour (built on first use).
+    fn blend_table(&mut self, color: Rgba) -> [u8; 256] {
+        let pal = self.palette;
+        *self.blends.entry(color).or_insert_with(|| {
+            let a = f64::from(color[3]) / 255.0;
+            let mut t = [0u8; 256];
+            for (i, e) in t.iter_mut().enumerate() {
+                let under = pal.color(i as u8);
+                let c = [0, 1, 2].map(|k| {
+                    (f64::from(color[k]) * a + f64::from(under[k]) * (1.0 - a)).round() as u8
+                });
+                *e = pal.index(c[0], c[1], c[2]);
+            }
+            t
+        })
     }
 
-    /// Fill the polygon `pts` (pixel coordinates, y down; closed implicitly) with `color`
-    /// by the nonzero winding rule, sampling pixel centres.
-    pub fn fill(&mut self, pts: &[[f64; 2]], color: Rgba) {
+    /// One straight piece of a stroke: the rectangle `width` wide around `a`–`b`, or for
+    /// an opaque stroke at most a pixel wide, a hairline.
+    fn segment(&mut self, a: [f64; 2], b: [f64; 2], width: f64, color: Rgba) {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let len = dx.hypot(dy);
+        if len.is_nan() || len <= 0.0 {
+            return;
+        }
+        if width <= 1.0 && color[3] == 255 {
+            let e = self.palette.index(color[0], color[1], color[2]);
+            self.hairline(a, b, e);
+            return;
+        }
+        let (nx, ny) = (-dy / len * width / 2.0, dx / len * width / 2.0);
+        self.fill(
+            &[
+                [a[0] + nx, a[1] + ny],
+                [b[0] + nx, b[1] + ny],
+                [b[0] - nx, b[1] - ny],
+                [a[0] - nx, a[1] - ny],
+            ],
+            color,
+        );
+    }
+
+    /// One pixel per column (per row, for a steep line) whose centre lies between the ends:
+    /// the pixel the line crosses that centre line in.
+    fn hairline(&mut self, a: [f64; 2], b: [f64; 2], entry: u8) {
+        // Along the major axis `m`, across it `c`; (w, h) in the same roles.
+        let steep = (b[1] - a[1]).abs() > (b[0] - a[0]).abs();
+        let (m, c, along, across) = if steep {
+            (1, 0, self.h, self.w)
+        } else {
+            (0, 1, self.w, self.h)
+        };
+        let (p, q) = if a[m] <= b[m] { (a, b) } else { (b, a) };
+        let slope = (q[c] - p[c]) / (q[m] - p[m]);
+        for k in centre_index(p[m], along)..centre_index(q[m], along) {
+            let at = p[c] + (k as f64 + 0.5 - p[m]) * slope;
+            // The pixel containing `at` (floor, through i64: no libm call).
+            let t = at as i64;
+            let j = if (t as f64) > at { t - 1 } else { t };
+            if (0..across as i64).contains(&j) {
+                let j = j as usize;
+                let i = if steep {
+                    k * self.w + j
+                } else {
+                    j * self.w + k
+                };
+                self.px[i] = entry;
+            }
+        }
+    }
+}
+
+impl Canvas for Indexed<'_> {
+    fn size(&self) -> (u32, u32) {
+        (self.w as u32, self.h as u32)
+    }
+
+    fn fill(&mut self, pts: &[[f64; 2]], color: Rgba) {
         if pts.len() < 3 || pts.iter().any(|p| !(p[0].is_finite() && p[1].is_finite())) {
             return;
         }
@@ -149,33 +244,8 @@ impl<'p> Indexed<'p> {
         self.edges = edges;
     }
 
-    /// The table of a translucent colour (built on first use).
-    fn blend_table(&mut self, color: Rgba) -> [u8; 256] {
-        let pal = self.palette;
-        *self.blends.entry(color).or_insert_with(|| {
-            let a = f64::from(color[3]) / 255.0;
-            let mut t = [0u8; 256];
-            for (i, e) in t.iter_mut().enumerate() {
-                let under = pal.color(i as u8);
-                let c = [0, 1, 2].map(|k| {
-                    (f64::from(color[k]) * a + f64::from(under[k]) * (1.0 - a)).round() as u8
-                });
-                *e = pal.index(c[0], c[1], c[2]);
-            }
-            t
-        })
-    }
-
-    /// Stroke the polyline `pts` (closed when `close`) `width` pixels wide with butt ends;
-    /// `dash`: lengths on and off, continued across corners.
-    pub fn stroke(
-        &mut self,
-        pts: &[[f64; 2]],
-        close: bool,
-        color: Rgba,
-        width: f64,
-        dash: Option<[f64; 2]>,
-    ) {
+    fn stroke(&mut self, pts: &[[f64; 2]], close: bool, pen: Pen) {
+        let Pen { color, width, dash } = pen;
         let n = pts.len();
         let segments = if close && n > 2 {
             n
@@ -215,63 +285,7 @@ impl<'p> Indexed<'p> {
         }
     }
 
-    /// One straight piece of a stroke: the rectangle `width` wide around `a`–`b`, or for
-    /// an opaque stroke at most a pixel wide, a hairline.
-    fn segment(&mut self, a: [f64; 2], b: [f64; 2], width: f64, color: Rgba) {
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        let len = dx.hypot(dy);
-        if len.is_nan() || len <= 0.0 {
-            return;
-        }
-        if width <= 1.0 && color[3] == 255 {
-            let e = self.palette.index(color[0], color[1], color[2]);
-            self.hairline(a, b, e);
-            return;
-        }
-        let (nx, ny) = (-dy / len * width / 2.0, dx / len * width / 2.0);
-        self.fill(
-            &[
-                [a[0] + nx, a[1] + ny],
-                [b[0] + nx, b[1] + ny],
-                [b[0] - nx, b[1] - ny],
-                [a[0] - nx, a[1] - ny],
-            ],
-            color,
-        );
-    }
-
-    /// One pixel per column (per row, for a steep line) whose centre lies between the ends:
-    /// the pixel the line crosses that centre line in.
-    fn hairline(&mut self, a: [f64; 2], b: [f64; 2], entry: u8) {
-        // Along the major axis `m`, across it `c`; (w, h) in the same roles.
-        let steep = (b[1] - a[1]).abs() > (b[0] - a[0]).abs();
-        let (m, c, along, across) = if steep {
-            (1, 0, self.h, self.w)
-        } else {
-            (0, 1, self.w, self.h)
-        };
-        let (p, q) = if a[m] <= b[m] { (a, b) } else { (b, a) };
-        let slope = (q[c] - p[c]) / (q[m] - p[m]);
-        for k in centre_index(p[m], along)..centre_index(q[m], along) {
-            let at = p[c] + (k as f64 + 0.5 - p[m]) * slope;
-            // The pixel containing `at` (floor, through i64: no libm call).
-            let t = at as i64;
-            let j = if (t as f64) > at { t - 1 } else { t };
-            if (0..across as i64).contains(&j) {
-                let j = j as usize;
-                let i = if steep {
-                    k * self.w + j
-                } else {
-                    j * self.w + k
-                };
-                self.px[i] = entry;
-            }
-        }
-    }
-
-    /// A disc of radius `r` around `c` in `fill` with a ring one pixel wide in `ring` on
-    /// its edge (as a stroke of width 1 on the circle would be).
-    pub fn dot(&mut self, c: [f64; 2], r: f64, fill: Rgba, ring: Rgba) {
+    fn dot(&mut self, c: [f64; 2], r: f64, fill: Rgba, ring: Rgba) {
         let circle = |r: f64| -> Vec<[f64; 2]> {
             (0..32)
                 .map(|k| {
@@ -303,6 +317,15 @@ mod tests {
 
     const WHITE: Rgba = [255, 255, 255, 255];
     const INK: Rgba = [50, 50, 50, 255];
+
+    /// A one-pixel pen in `INK`.
+    fn pen(dash: Option<[f64; 2]>) -> Pen {
+        Pen {
+            color: INK,
+            width: 1.0,
+            dash,
+        }
+    }
 
     /// Whether `p` is inside polygon `pts` by the nonzero rule (winding number ≠ 0).
     fn inside(pts: &[[f64; 2]], p: [f64; 2]) -> bool {
@@ -395,7 +418,7 @@ mod tests {
             ([30.1, 2.2], [29.4, 47.6]),
         ] {
             let mut pic = Indexed::new(60, 50, WHITE, pal);
-            pic.stroke(&[a, b], false, INK, 1.0, None);
+            pic.stroke(&[a, b], false, pen(None));
             // Every column (or row, for steep lines) between the ends holds the line.
             let steep = (b[1] - a[1]).abs() > (b[0] - a[0]).abs();
             let (lo, hi) = if steep {
@@ -419,13 +442,7 @@ mod tests {
         }
         // A horizontal dashed line along a pixel row's centre: 4 on, 3 off.
         let mut pic = Indexed::new(40, 3, WHITE, pal);
-        pic.stroke(
-            &[[0.0, 1.5], [40.0, 1.5]],
-            false,
-            INK,
-            1.0,
-            Some([4.0, 3.0]),
-        );
+        pic.stroke(&[[0.0, 1.5], [40.0, 1.5]], false, pen(Some([4.0, 3.0])));
         let row: Vec<bool> = pic.px[40..80].iter().map(|&p| p == ink).collect();
         for (x, &on) in row.iter().enumerate() {
             assert_eq!(on, x % 7 < 4, "pixel {x}");

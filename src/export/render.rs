@@ -13,7 +13,7 @@
 use rayon::prelude::*;
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
 
-use super::raster::{self, Indexed};
+use super::raster::{self, Canvas, Indexed, Pen};
 use super::{DesignMeta, ExportError, Result, validate_meta, validate_pattern};
 use crate::geom::{self, V3};
 use crate::pattern::Pattern;
@@ -181,25 +181,6 @@ fn rgba(c: Rgba) -> raster::Rgba {
     [c.0, c.1, c.2, c.3]
 }
 
-/// What [`Scene::draw_on`] draws on, in pixel coordinates (y down).
-trait Canvas {
-    /// Width and height in pixels.
-    fn size(&self) -> (u32, u32);
-    /// Fill a polygon (nonzero winding).
-    fn fill(&mut self, pts: &[[f64; 2]], color: raster::Rgba);
-    /// Stroke a polyline (closed when `close`); `dash`: lengths on and off.
-    fn stroke(
-        &mut self,
-        pts: &[[f64; 2]],
-        close: bool,
-        color: raster::Rgba,
-        width: f64,
-        dash: Option<[f64; 2]>,
-    );
-    /// A filled disc with a one-pixel ring on its edge.
-    fn dot(&mut self, c: [f64; 2], r: f64, fill: raster::Rgba, ring: raster::Rgba);
-}
-
 /// tiny-skia, anti-aliased: the PNG pictures.
 struct Skia<'a>(&'a mut Pixmap);
 
@@ -245,14 +226,8 @@ impl Canvas for Skia<'_> {
         }
     }
 
-    fn stroke(
-        &mut self,
-        pts: &[[f64; 2]],
-        close: bool,
-        color: raster::Rgba,
-        width: f64,
-        dash: Option<[f64; 2]>,
-    ) {
+    fn stroke(&mut self, pts: &[[f64; 2]], close: bool, pen: Pen) {
+        let Pen { color, width, dash } = pen;
         let Some(path) = Self::path(pts, close) else {
             return;
         };
@@ -275,32 +250,6 @@ impl Canvas for Skia<'_> {
             };
             (self.0).stroke_path(&path, &Self::paint(ring), &st, t, None);
         }
-    }
-}
-
-impl Canvas for Indexed<'_> {
-    fn size(&self) -> (u32, u32) {
-        let (w, h) = Indexed::size(self);
-        (w as u32, h as u32)
-    }
-
-    fn fill(&mut self, pts: &[[f64; 2]], color: raster::Rgba) {
-        Indexed::fill(self, pts, color);
-    }
-
-    fn stroke(
-        &mut self,
-        pts: &[[f64; 2]],
-        close: bool,
-        color: raster::Rgba,
-        width: f64,
-        dash: Option<[f64; 2]>,
-    ) {
-        Indexed::stroke(self, pts, close, color, width, dash);
-    }
-
-    fn dot(&mut self, c: [f64; 2], r: f64, fill: raster::Rgba, ring: raster::Rgba) {
-        Indexed::dot(self, c, r, fill, ring);
     }
 }
 
@@ -580,7 +529,15 @@ impl<'a> Scene<'a> {
                     let q = px(&pts);
                     canvas.fill(&q, rgba(fill));
                     if let Some(o) = outline {
-                        canvas.stroke(&q, true, rgba(o), 1.0, None);
+                        canvas.stroke(
+                            &q,
+                            true,
+                            Pen {
+                                color: rgba(o),
+                                width: 1.0,
+                                dash: None,
+                            },
+                        );
                     }
                 }
                 Item::Polyline {
@@ -591,9 +548,11 @@ impl<'a> Scene<'a> {
                 } => canvas.stroke(
                     &px(&pts),
                     false,
-                    rgba(color),
-                    width,
-                    dashed.then_some([4.0, 3.0]),
+                    Pen {
+                        color: rgba(color),
+                        width,
+                        dash: dashed.then_some([4.0, 3.0]),
+                    },
                 ),
                 Item::Dot { at, color, radius } => {
                     canvas.dot(fit(at), radius, rgba(color), rgba(WHITE));
@@ -601,7 +560,15 @@ impl<'a> Scene<'a> {
             }
         }
         for (a, b, c, _) in self.axes_lines(size) {
-            canvas.stroke(&[a, b], false, rgba(c), 2.0, None);
+            canvas.stroke(
+                &[a, b],
+                false,
+                Pen {
+                    color: rgba(c),
+                    width: 2.0,
+                    dash: None,
+                },
+            );
         }
     }
 
