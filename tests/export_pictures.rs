@@ -63,3 +63,71 @@ fn gif_has_the_picked_frames_and_they_move() {
     assert_eq!(frames[0].0, 4);
     assert!(frames[11].0 > 4);
 }
+
+/// `foldsynth bench export` measures every part of one design's files and the two LZW
+/// encoders on the same data; a missing file is an error that names it.
+#[test]
+fn bench_export_reports_every_part() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let design = dir.path().join("design.json");
+    let d = foldsynth::export::DesignFile {
+        pattern: samples::single_crease(2.0, 20),
+        meta: DesignMeta {
+            task: "bench".into(),
+            ..DesignMeta::default()
+        },
+    };
+    std::fs::write(&design, serde_json::to_string(&d).unwrap()).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_foldsynth"))
+        .args(["bench", "export"])
+        .arg(&design)
+        .args(["--millis", "1", "--json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let parts: Vec<&str> = v["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            assert!(r["ns"].as_f64().unwrap() > 0.0, "{r}");
+            r["part"].as_str().unwrap()
+        })
+        .collect();
+    for want in [
+        "FOLD file",
+        "crease-pattern SVG",
+        "OBJ and STL of the last state",
+        "PNG pictures: draw, anti-aliased",
+        "PNG pictures: encode",
+        "SVG pictures of the same states",
+        "GIF frames: draw into palette entries",
+        "GIF frames: delta rectangles",
+        "GIF frames: LZW (export::lzw)",
+    ] {
+        assert!(parts.contains(&want), "{want} missing from {parts:?}");
+    }
+    // 20 frames, all in the GIF; the default 4 pictures.
+    assert_eq!(v["gif_frames"], 20, "{v}");
+    assert_eq!(v["pictures"], 4, "{v}");
+    let lzw = &v["lzw"];
+    // 20 frames of 480×360 at most, the first whole.
+    let input = lzw["input_bytes"].as_u64().unwrap();
+    assert!((480 * 360..=20 * 480 * 360).contains(&input), "{lzw}");
+    assert!(lzw["ours_bytes"].as_u64().unwrap() > 0, "{lzw}");
+    assert!(lzw["gif_crate_bytes"].as_u64().unwrap() > 0, "{lzw}");
+    assert!(v["write_all_ns"].as_f64().unwrap() > 0.0, "{v}");
+
+    let o = Command::new(env!("CARGO_BIN_EXE_foldsynth"))
+        .args(["bench", "export", "no-such-design.json"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("no-such-design.json"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}

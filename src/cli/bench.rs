@@ -36,6 +36,9 @@ pub enum BenchCommand {
     /// One folding motion of one design: the compiled PTU model against the bar-and-hinge
     /// simulation (thesis Sec. 3), same states.
     Numeric(super::bench_numeric::NumericBenchArgs),
+    /// One design's files, part by part (FOLD, SVG, meshes, pictures, GIF frames and their
+    /// LZW against the gif crate's), on one thread.
+    Export(super::bench_export::ExportBenchArgs),
 }
 
 /// Run `foldsynth bench`.
@@ -44,6 +47,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         BenchCommand::Vertex(a) => run_vertex(a),
         BenchCommand::Model(a) => super::bench_model::run(a),
         BenchCommand::Numeric(a) => super::bench_numeric::run(a),
+        BenchCommand::Export(a) => super::bench_export::run(a),
     }
 }
 

@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod bench;
+pub mod bench_export;
 pub mod bench_model;
 pub mod bench_numeric;
 pub mod bench_symbolica;

@@ -29,6 +29,10 @@ pub struct Indexed<'p> {
     crossings: Vec<(f64, i32)>,
     /// The edges of the polygon being filled, reused.
     edges: Vec<Edge>,
+    /// The spans of the polygon being filled, reused.
+    spans: Vec<[u32; 3]>,
+    /// The spans of the translucent polygons drawn so far, by their coordinates' bits.
+    kept: HashMap<Vec<u64>, Vec<[u32; 3]>>,
 }
 
 /// A polygon edge that is not horizontal.
@@ -78,15 +82,96 @@ impl<'p> Indexed<'p> {
             blends: HashMap::new(),
             crossings: Vec::new(),
             edges: Vec::new(),
+            spans: Vec::new(),
+            kept: HashMap::new(),
         }
     }
 
-    /// Fill the whole picture with the entry of `background` (the blend tables stay).
+    /// Fill the whole picture with the entry of `background` (the blend tables and the
+    /// translucent polygons' spans stay).
     pub fn clear(&mut self, background: Rgba) {
         let e = self
             .palette
             .index(background[0], background[1], background[2]);
-        self.px.fill(e);
+        if self.px.len() == self.w * self.h {
+            self.px.fill(e);
+        } else {
+            // Taken by [`Indexed::take`]: a new buffer, filled as it is allocated.
+            self.px = vec![e; self.w * self.h];
+        }
+    }
+
+    /// The picture's entries, leaving it without pixels until the next [`Indexed::clear`]
+    /// (drawing on it before then draws nothing), so a caller keeping every frame does not
+    /// copy each one.
+    pub fn take(&mut self) -> Vec<u8> {
+        std::mem::take(&mut self.px)
+    }
+
+    /// The spans `[row, first, end)` of the pixels whose centres are inside polygon `pts`
+    /// by the nonzero winding rule, into `out` (cleared first).
+    fn spans_of(&mut self, pts: &[[f64; 2]], out: &mut Vec<[u32; 3]>) {
+        out.clear();
+        if pts.len() < 3 || pts.iter().any(|p| !(p[0].is_finite() && p[1].is_finite())) {
+            return;
+        }
+        let (lo, hi) = pts
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p[1]), hi.max(p[1]))
+            });
+        // Rows whose centre y + ½ lies in [lo, hi).
+        let (first, last) = (centre_index(lo, self.h), centre_index(hi, self.h));
+        // Each edge once: where it starts, its slope dx/dy, its rows' y range, its direction.
+        let mut edges = std::mem::take(&mut self.edges);
+        edges.clear();
+        for (a, b) in pts.iter().zip(pts.iter().cycle().skip(1)) {
+            if a[1] != b[1] {
+                let (lo, hi) = if a[1] < b[1] {
+                    (a[1], b[1])
+                } else {
+                    (b[1], a[1])
+                };
+                edges.push(Edge {
+                    x: a[0],
+                    y: a[1],
+                    slope: (b[0] - a[0]) / (b[1] - a[1]),
+                    lo,
+                    hi,
+                    dir: if b[1] > a[1] { 1 } else { -1 },
+                });
+            }
+        }
+        let mut crossings = std::mem::take(&mut self.crossings);
+        for y in first..last {
+            let yc = y as f64 + 0.5;
+            crossings.clear();
+            // Half-open in y, so a vertex on the row is counted once.
+            crossings.extend(
+                edges
+                    .iter()
+                    .filter(|e| e.lo <= yc && yc < e.hi)
+                    .map(|e| (e.x + (yc - e.y) * e.slope, e.dir)),
+            );
+            crossings.sort_unstable_by(|p, q| p.0.total_cmp(&q.0));
+            let mut winding = 0;
+            for pair in crossings.windows(2) {
+                winding += pair[0].1;
+                if winding == 0 {
+                    continue;
+                }
+                // Pixels whose centre x + ½ lies in [x0, x1).
+                let (x0, x1) = (
+                    centre_index(pair[0].0, self.w),
+                    centre_index(pair[1].0, self.w),
+                );
+                if x0 < x1 {
+                    out.push([y as u32, x0 as u32, x1 as u32]);
+                }
+            }
+        }
+        self.crossings = crossings;
+        self.edges = edges;
     }
 
     /// The table of a translucent colour (built on first use).
@@ -134,6 +219,9 @@ impl<'p> Indexed<'p> {
     /// One pixel per column (per row, for a steep line) whose centre lies between the ends:
     /// the pixel the line crosses that centre line in.
     fn hairline(&mut self, a: [f64; 2], b: [f64; 2], entry: u8) {
+        if self.px.len() != self.w * self.h {
+            return;
+        }
         // Along the major axis `m`, across it `c`; (w, h) in the same roles.
         let steep = (b[1] - a[1]).abs() > (b[0] - a[0]).abs();
         let (m, c, along, across) = if steep {
@@ -167,81 +255,43 @@ impl Canvas for Indexed<'_> {
     }
 
     fn fill(&mut self, pts: &[[f64; 2]], color: Rgba) {
-        if pts.len() < 3 || pts.iter().any(|p| !(p[0].is_finite() && p[1].is_finite())) {
+        if self.px.len() != self.w * self.h {
             return;
         }
-        let (lo, hi) = pts
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p[1]), hi.max(p[1]))
-            });
-        // Rows whose centre y + ½ lies in [lo, hi).
-        let (first, last) = (centre_index(lo, self.h), centre_index(hi, self.h));
-        if first >= last {
-            return;
-        }
-        let blend = match color[3] {
-            255 => None,
-            0 => return,
-            _ => Some(self.blend_table(color)),
-        };
-        let opaque = self.palette.index(color[0], color[1], color[2]);
-        // Each edge once: where it starts, its slope dx/dy, its rows' y range, its direction.
-        let mut edges = std::mem::take(&mut self.edges);
-        edges.clear();
-        for (a, b) in pts.iter().zip(pts.iter().cycle().skip(1)) {
-            if a[1] != b[1] {
-                let (lo, hi) = if a[1] < b[1] {
-                    (a[1], b[1])
-                } else {
-                    (b[1], a[1])
+        match color[3] {
+            0 => {}
+            255 => {
+                let mut spans = std::mem::take(&mut self.spans);
+                self.spans_of(pts, &mut spans);
+                let e = self.palette.index(color[0], color[1], color[2]);
+                for &[y, x0, x1] in &spans {
+                    let row = y as usize * self.w;
+                    self.px[row + x0 as usize..row + x1 as usize].fill(e);
+                }
+                self.spans = spans;
+            }
+            _ => {
+                // Translucent polygons are the obstacle, the same in every frame: their
+                // spans are kept, keyed by the exact coordinates.
+                let key: Vec<u64> = pts.iter().flat_map(|p| p.map(f64::to_bits)).collect();
+                let spans = match self.kept.remove(&key) {
+                    Some(spans) => spans,
+                    None => {
+                        let mut spans = Vec::new();
+                        self.spans_of(pts, &mut spans);
+                        spans
+                    }
                 };
-                let slope = (b[0] - a[0]) / (b[1] - a[1]);
-                edges.push(Edge {
-                    x: a[0],
-                    y: a[1],
-                    slope,
-                    lo,
-                    hi,
-                    dir: if b[1] > a[1] { 1 } else { -1 },
-                });
+                let t = self.blend_table(color);
+                for &[y, x0, x1] in &spans {
+                    let row = y as usize * self.w;
+                    for p in &mut self.px[row + x0 as usize..row + x1 as usize] {
+                        *p = t[usize::from(*p)];
+                    }
+                }
+                self.kept.insert(key, spans);
             }
         }
-        let mut crossings = std::mem::take(&mut self.crossings);
-        for y in first..last {
-            let yc = y as f64 + 0.5;
-            crossings.clear();
-            // Half-open in y, so a vertex on the row is counted once.
-            crossings.extend(
-                edges
-                    .iter()
-                    .filter(|e| e.lo <= yc && yc < e.hi)
-                    .map(|e| (e.x + (yc - e.y) * e.slope, e.dir)),
-            );
-            crossings.sort_unstable_by(|p, q| p.0.total_cmp(&q.0));
-            let row = &mut self.px[y * self.w..(y + 1) * self.w];
-            let mut winding = 0;
-            for pair in crossings.windows(2) {
-                winding += pair[0].1;
-                if winding == 0 {
-                    continue;
-                }
-                // Pixels whose centre x + ½ lies in [x0, x1).
-                let (x0, x1) = (
-                    centre_index(pair[0].0, self.w),
-                    centre_index(pair[1].0, self.w),
-                );
-                if x0 >= x1 {
-                    continue;
-                }
-                match &blend {
-                    None => row[x0..x1].fill(opaque),
-                    Some(t) => row[x0..x1].iter_mut().for_each(|p| *p = t[usize::from(*p)]),
-                }
-            }
-        }
-        self.crossings = crossings;
-        self.edges = edges;
     }
 
     fn stroke(&mut self, pts: &[[f64; 2]], close: bool, pen: Pen) {
@@ -405,6 +455,30 @@ mod tests {
         assert_eq!(row[3], over(ink));
         assert_eq!(row[6], over(white));
         assert_ne!(row[3], row[6]);
+    }
+
+    #[test]
+    fn a_kept_translucent_polygon_paints_what_a_fresh_one_does() {
+        let pal = gif_palette();
+        let glass: Rgba = [150, 156, 166, 150];
+        let quad = [[3.3, 2.1], [35.6, 9.8], [30.2, 27.5], [6.1, 20.4]];
+        let under = [[0.0, 0.0], [20.0, 0.0], [20.0, 30.0], [0.0, 30.0]];
+        let draw = |pic: &mut Indexed, shift: f64| {
+            pic.clear(WHITE);
+            let moved: Vec<[f64; 2]> = under.iter().map(|p| [p[0] + shift, p[1]]).collect();
+            pic.fill(&moved, INK);
+            pic.fill(&quad, glass);
+        };
+        // One picture reused over frames (the glass's spans kept after the first), against
+        // a fresh picture per frame; what is under the glass changes from frame to frame.
+        let mut reused = Indexed::new(40, 30, WHITE, pal);
+        for shift in [0.0, 7.5, 13.25] {
+            draw(&mut reused, shift);
+            let mut fresh = Indexed::new(40, 30, WHITE, pal);
+            draw(&mut fresh, shift);
+            assert!(reused.px == fresh.px, "shift {shift}");
+        }
+        assert_eq!(reused.kept.len(), 1);
     }
 
     #[test]

@@ -518,6 +518,29 @@ impl<'a> Scene<'a> {
         self.draw_on(pic, frame);
     }
 
+    /// The GIF's frame `k` of `n`: pattern frame `frame_index`, hard-edged, with the
+    /// progress bar.
+    fn gif_frame(&self, pic: &mut Indexed, frame_index: usize, k: usize, n: usize) {
+        self.draw_indexed(pic, Some(frame_index));
+        draw_progress(pic, k, n);
+    }
+
+    /// The GIF's frames as palette entries, drawn one after the other (what
+    /// [`Scene::gif_and_pngs`] draws in parallel; for `foldsynth bench export`).
+    pub(crate) fn gif_frames(&self, size: (u32, u32), max_frames: usize) -> Result<Vec<Vec<u8>>> {
+        Self::check_size(size)?;
+        let picked = super::picked_frames(self.pattern.frames.len(), max_frames.max(2));
+        let mut pic = Indexed::new(size.0, size.1, rgba(WHITE), gif_palette());
+        Ok(picked
+            .iter()
+            .enumerate()
+            .map(|(k, &f)| {
+                self.gif_frame(&mut pic, f, k, picked.len());
+                pic.take()
+            })
+            .collect())
+    }
+
     /// Draw one state's items and the axes on `canvas` (fitted to its size).
     fn draw_on(&self, canvas: &mut impl Canvas, frame: Option<usize>) {
         let size = canvas.size();
@@ -658,9 +681,8 @@ impl<'a> Scene<'a> {
                     } else {
                         None
                     };
-                    self.draw_indexed(pic, Some(frame_index));
-                    draw_progress(pic, k, n);
-                    Ok((pic.px.clone(), png))
+                    self.gif_frame(pic, frame_index, k, n);
+                    Ok((pic.take(), png))
                 },
             )
             .collect::<Result<_>>()?;
@@ -852,7 +874,7 @@ fn draw_progress(pic: &mut Indexed, k: usize, n: usize) {
 /// The GIF frame that turns picture `prev` into `cur` (both `w`×`h` palette indices) when
 /// drawn over it: the bounding rectangle of the changed pixels, unchanged ones inside it
 /// set to `transparent` (an index neither picture uses). No change: one transparent pixel.
-fn delta_frame(
+pub(crate) fn delta_frame(
     prev: &[u8],
     cur: &[u8],
     w: usize,
@@ -888,15 +910,13 @@ fn delta_frame(
         return gif::Frame::from_indexed_pixels(1, 1, vec![transparent], Some(transparent));
     }
     let (fw, fh) = (right - left + 1, bottom - top + 1);
-    let mut buf = Vec::with_capacity(fw * fh);
-    for y in top..=bottom {
+    // Written into a sized buffer row by row (a loop the compiler vectorizes).
+    let mut buf = vec![0u8; fw * fh];
+    for (y, out) in (top..=bottom).zip(buf.chunks_exact_mut(fw)) {
         let row = y * w + left..y * w + right + 1;
-        buf.extend(
-            prev[row.clone()]
-                .iter()
-                .zip(&cur[row])
-                .map(|(&p, &q)| if p == q { transparent } else { q }),
-        );
+        for ((o, &p), &q) in out.iter_mut().zip(&prev[row.clone()]).zip(&cur[row]) {
+            *o = if p == q { transparent } else { q };
+        }
     }
     let mut frame = gif::Frame::from_indexed_pixels(fw as u16, fh as u16, buf, Some(transparent));
     frame.left = left as u16;
