@@ -196,7 +196,8 @@ impl<'p> Indexed<'p> {
     fn segment(&mut self, a: [f64; 2], b: [f64; 2], width: f64, color: Rgba) {
         let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
         let len = dx.hypot(dy);
-        if len.is_nan() || len <= 0.0 {
+        // Not finite: nothing a hairline or a rectangle could be drawn from.
+        if !(len.is_finite() && len > 0.0) {
             return;
         }
         if width <= 1.0 && color[3] == 255 {
@@ -310,7 +311,8 @@ impl Canvas for Indexed<'_> {
             if len.is_nan() || len <= 0.0 {
                 continue;
             }
-            match dash {
+            match dash.filter(|[on, off]| *on > 0.0 && *off >= 0.0) {
+                // No dash, or none that can be walked: a solid line.
                 None => self.segment(a, b, width, color),
                 Some([on, off]) => {
                     let period = on + off;

@@ -628,9 +628,8 @@ impl<'a> Scene<'a> {
     /// quantization). After the first frame each frame holds only the rectangle
     /// that changed, with unchanged pixels in it transparent (disposal "keep"), so a
     /// viewer composes exactly the full pictures while LZW reads far fewer, far more
-    /// repetitive bytes ([`super::lzw`], with its fast path for runs). Frames are drawn,
-    /// mapped and compressed in parallel; only the byte
-    /// stream is written in order.
+    /// repetitive bytes ([`super::lzw`], with its fast path for runs). Frames are drawn
+    /// and compressed in parallel; only the byte stream is written in order.
     pub fn gif(&self, size: (u32, u32), delay_cs: u16, max_frames: usize) -> Result<Vec<u8>> {
         Ok(self.gif_and_pngs(size, delay_cs, max_frames, &[])?.0)
     }
