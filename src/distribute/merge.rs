@@ -19,7 +19,7 @@ use std::time::Instant;
 use super::DistributeError;
 use super::shard::assign;
 use crate::grammar::Rules;
-use crate::search::output::{RECORDS, RunSettings, SETTINGS, ShardSpec};
+use crate::search::output::{OutputDir, RECORDS, RunSettings, SETTINGS, ShardSpec};
 use crate::search::plan::Done;
 use crate::search::{
     self, AlternativeRecord, Evaluation, FailedModel, Plan, SHARD_REPORT, SHARD_TASK,
@@ -300,6 +300,45 @@ fn check_records(
 /// Merge the shard directories `dirs` into `opts.out`.
 pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, DistributeError> {
     let start = Instant::now();
+    let shards = read_shards(dirs, &opts.out)?;
+    let (task, _) = read_task(&shards)?;
+    let settings = RunSettings {
+        shard: None,
+        ..shards[0].settings.clone()
+    };
+    let search_opts = search_options(&settings, &shards[0], opts)?;
+    let n_max = search::check_search(&task, &search_opts)?;
+    let plan = search::plan(&task, n_max, search_opts.rules)?;
+    let deal = assign(&plan, shards[0].spec.count);
+    // Every shard complete, every record in its place, before anything is written.
+    let (failed, compile_s) = check_complete(&plan, &shards, &deal, &settings)?;
+
+    let (out, _) = search::open_output(&settings, &search_opts)?;
+    copy_records(&shards, &out)?;
+    let ev = Evaluation {
+        compile_s,
+        jobs: rayon::ThreadPoolBuilder::new()
+            .num_threads(opts.jobs)
+            .build()
+            .map_or(1, |p| p.current_num_threads()),
+        resumed: 0,
+        resume: None,
+        failed,
+    };
+    Ok(search::finish(
+        &task,
+        &plan,
+        &out,
+        &search_opts,
+        &ev,
+        start,
+        &search::Progress::new(search_opts.progress),
+    )?)
+}
+
+/// The shard directories `dirs`, read and checked to be one search (shards 1 … N each
+/// given once), in shard order; none of them the merged run's directory `out`.
+fn read_shards(dirs: &[PathBuf], out: &Path) -> Result<Vec<ShardDir>, DistributeError> {
     if dirs.is_empty() {
         return Err(DistributeError::input(
             "merge",
@@ -313,11 +352,11 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
     check_one_search(&shards)?;
     shards.sort_by_key(|s| s.spec.index);
     // The merged run must not replace a shard it reads.
-    if let Ok(out) = std::fs::canonicalize(&opts.out) {
+    if let Ok(canonical) = std::fs::canonicalize(out) {
         for s in &shards {
-            if std::fs::canonicalize(&s.dir).is_ok_and(|d| d == out) {
+            if std::fs::canonicalize(&s.dir).is_ok_and(|d| d == canonical) {
                 return Err(DistributeError::input(
-                    &opts.out,
+                    out,
                     format!(
                         "is shard {}'s own directory; give the merged run a directory of its own",
                         s.spec
@@ -326,18 +365,22 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
             }
         }
     }
-    let (task, _) = read_task(&shards)?;
-    let settings = RunSettings {
-        shard: None,
-        ..shards[0].settings.clone()
-    };
+    Ok(shards)
+}
+
+/// The search's options for the merged run: the shards' `settings` (read from `first`),
+/// the merge's own `opts`.
+fn search_options(
+    settings: &RunSettings,
+    first: &ShardDir,
+    opts: &MergeOptions,
+) -> Result<SearchOptions, DistributeError> {
     let rules = match &settings.rules {
         None => Rules::default(),
-        Some(names) => Rules::parse(names).map_err(|m| {
-            DistributeError::input(shards[0].dir.join(SETTINGS), format!("rules: {m}"))
-        })?,
+        Some(names) => Rules::parse(names)
+            .map_err(|m| DistributeError::input(first.dir.join(SETTINGS), format!("rules: {m}")))?,
     };
-    let search_opts = SearchOptions {
+    Ok(SearchOptions {
         out: opts.out.clone(),
         jobs: opts.jobs,
         starts: settings.starts,
@@ -350,46 +393,31 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
         progress: false,
         rules,
         post_check_only: settings.post_check_only,
-    };
-    let n_max = search::check_search(&task, &search_opts)?;
-    let plan = search::plan(&task, n_max, rules)?;
-    let deal = assign(&plan, shards[0].spec.count);
+    })
+}
 
-    // Every shard complete, every record in its place, before anything is written.
+/// Check that every shard holds every alternative of its units (`deal`) once, the
+/// alternatives of its failed models excepted; an error names each incomplete shard with
+/// what it lacks and the command that resumes it. The failed models of all shards and
+/// their compile seconds.
+fn check_complete(
+    plan: &Plan,
+    shards: &[ShardDir],
+    deal: &[Vec<usize>],
+    settings: &RunSettings,
+) -> Result<(Vec<FailedModel>, f64), DistributeError> {
     let mut done = Done::new(plan.alternatives);
     let mut incomplete = Vec::new();
     let mut failed: Vec<FailedModel> = Vec::new();
     let mut compile_s = 0.0;
-    for s in &shards {
+    for s in shards {
         let units = &deal[s.spec.index - 1];
         let mut mine = vec![false; plan.units.len()];
         for &u in units {
             mine[u] = true;
         }
-        check_records(&plan, s, &mine, &mut done)?;
-        let failed_here: HashSet<(String, usize)> = s
-            .report
-            .iter()
-            .flat_map(|r| &r.failed_models)
-            .map(|f| (f.sequence.clone(), f.candidate))
-            .collect();
-        let mut missing = 0u64;
-        let mut shown = Vec::new();
-        for &u in units {
-            let unit = &plan.units[u];
-            let key = (plan.graphs[unit.graph].sequence.clone(), unit.candidate + 1);
-            if failed_here.contains(&key) {
-                continue;
-            }
-            for m in 0..unit.count {
-                if !done.contains(unit.first + m) {
-                    missing += 1;
-                    if shown.len() < MISSING_SHOWN {
-                        shown.push(plan.alternative(u, m as u32).key());
-                    }
-                }
-            }
-        }
+        check_records(plan, s, &mine, &mut done)?;
+        let (missing, shown) = missing_alternatives(plan, s, units, &done);
         if missing > 0 {
             incomplete.push(format!(
                 "shard {} ({}) lacks {missing} of its {} alternatives, e.g. {}{}; resume just that shard: foldsynth synthesize {} --shard {} --n-max {} --starts {} --seed {} --sweep {} --resume --out {}",
@@ -423,13 +451,50 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
             ),
         ));
     }
-    drop(done);
+    Ok((failed, compile_s))
+}
 
-    let (out, _) = search::open_output(&settings, &search_opts)?;
+/// How many alternatives of shard `s`'s `units` are not `done` (those of the models its
+/// report lists as failed excepted), and the keys of the first [`MISSING_SHOWN`].
+fn missing_alternatives(
+    plan: &Plan,
+    s: &ShardDir,
+    units: &[usize],
+    done: &Done,
+) -> (u64, Vec<String>) {
+    let failed_here: HashSet<(String, usize)> = s
+        .report
+        .iter()
+        .flat_map(|r| &r.failed_models)
+        .map(|f| (f.sequence.clone(), f.candidate))
+        .collect();
+    let mut missing = 0u64;
+    let mut shown = Vec::new();
+    for &u in units {
+        let unit = &plan.units[u];
+        let key = (plan.graphs[unit.graph].sequence.clone(), unit.candidate + 1);
+        if failed_here.contains(&key) {
+            continue;
+        }
+        for m in 0..unit.count {
+            if !done.contains(unit.first + m) {
+                missing += 1;
+                if shown.len() < MISSING_SHOWN {
+                    shown.push(plan.alternative(u, m as u32).key());
+                }
+            }
+        }
+    }
+    (missing, shown)
+}
+
+/// Copy the shards' records, in shard order, into the merged run's records file (torn
+/// last lines and blank lines left out).
+fn copy_records(shards: &[ShardDir], out: &OutputDir) -> Result<(), DistributeError> {
     let (path, file) = out.create(RECORDS)?;
     let mut w = std::io::BufWriter::new(file);
     let werr = |e: std::io::Error| DistributeError::input(&path, e.to_string());
-    for s in &shards {
+    for s in shards {
         let from = s.dir.join(RECORDS);
         let Ok(file) = File::open(&from) else {
             continue;
@@ -450,24 +515,5 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
         }
     }
     w.flush().map_err(werr)?;
-    drop(w);
-    let ev = Evaluation {
-        compile_s,
-        jobs: rayon::ThreadPoolBuilder::new()
-            .num_threads(opts.jobs)
-            .build()
-            .map_or(1, |p| p.current_num_threads()),
-        resumed: 0,
-        resume: None,
-        failed,
-    };
-    Ok(search::finish(
-        &task,
-        &plan,
-        &out,
-        &search_opts,
-        &ev,
-        start,
-        &search::Progress::new(search_opts.progress),
-    )?)
+    Ok(())
 }

@@ -115,25 +115,7 @@ pub fn write_scripts(
     opts: &SlurmOptions,
 ) -> Result<SlurmFiles, DistributeError> {
     let shown = |e: std::io::Error, p: &Path| DistributeError::input(p, e.to_string());
-    limits::check_count("shards", opts.shards as u64, 1, limits::SHARDS_MAX as u64)
-        .map_err(|m| DistributeError::input("--shards", m))?;
-    limits::check_count(
-        "cpus-per-task",
-        opts.cpus_per_task as u64,
-        1,
-        limits::JOBS_MAX as u64,
-    )
-    .map_err(|m| DistributeError::input("--cpus-per-task", m))?;
-    let partition = opts
-        .partition
-        .as_deref()
-        .map(|p| sbatch_value("partition", p))
-        .transpose()?;
-    let time = opts
-        .time
-        .as_deref()
-        .map(|t| sbatch_value("time", t))
-        .transpose()?;
+    let resources = sbatch_resources(opts)?;
     std::fs::create_dir_all(&opts.out).map_err(|e| shown(e, &opts.out))?;
     let dir = std::fs::canonicalize(&opts.out).map_err(|e| shown(e, &opts.out))?;
     let dir_text = dir.display().to_string();
@@ -147,17 +129,7 @@ pub fn write_scripts(
             "the directory's path contains whitespace or '%', which #SBATCH --output cannot take; choose another --out",
         ));
     }
-    let file_name = task_file
-        .file_name()
-        .map(|f| f.to_string_lossy().into_owned())
-        .filter(|f| !f.is_empty())
-        .unwrap_or_else(|| "task.toml".into());
-    for sub in ["task", "logs", "shards"] {
-        let p = dir.join(sub);
-        std::fs::create_dir_all(&p).map_err(|e| shown(e, &p))?;
-    }
-    let task_copy = dir.join("task").join(&file_name);
-    std::fs::write(&task_copy, task_text).map_err(|e| shown(e, &task_copy))?;
+    let task_copy = copy_task(&dir, task_file, task_text)?;
     let bin = quote(&opts.foldsynth.display().to_string());
     let n = opts.shards;
     let safe_name: String = task_name
@@ -171,33 +143,11 @@ pub fn write_scripts(
         })
         .take(40)
         .collect();
-    let mut settings = String::new();
-    if let Some(k) = opts.n_max {
-        settings += &format!(" --n-max {k}");
-    }
-    settings += &format!(
-        " --starts {} --seed {} --sweep {}",
-        opts.starts, opts.seed, opts.sweep
-    );
-    if opts.rules != crate::grammar::Rules::default() {
-        settings += &format!(" --rules {}", opts.rules.names());
-    }
-    if opts.post_check_only {
-        settings += " --post-check-only";
-    }
+    let settings = search_settings(opts);
     let header = |job: &str, log: &str| {
-        let mut h = format!(
-            "#!/bin/bash\n#SBATCH --job-name={job}\n#SBATCH --cpus-per-task={}\n",
-            opts.cpus_per_task
-        );
-        if let Some(p) = &partition {
-            h += &format!("#SBATCH --partition={p}\n");
-        }
-        if let Some(t) = &time {
-            h += &format!("#SBATCH --time={t}\n");
-        }
-        h += &format!("#SBATCH --output={dir_text}/logs/{log}\n");
-        h
+        format!(
+            "#!/bin/bash\n#SBATCH --job-name={job}\n{resources}#SBATCH --output={dir_text}/logs/{log}\n"
+        )
     };
     let shards_script = dir.join("shards.sbatch");
     let text = format!(
@@ -233,6 +183,75 @@ pub fn write_scripts(
         merge_script,
         result,
     })
+}
+
+/// The `#SBATCH` lines both jobs share (CPUs per task, partition, time), each value
+/// checked.
+fn sbatch_resources(opts: &SlurmOptions) -> Result<String, DistributeError> {
+    limits::check_count("shards", opts.shards as u64, 1, limits::SHARDS_MAX as u64)
+        .map_err(|m| DistributeError::input("--shards", m))?;
+    limits::check_count(
+        "cpus-per-task",
+        opts.cpus_per_task as u64,
+        1,
+        limits::JOBS_MAX as u64,
+    )
+    .map_err(|m| DistributeError::input("--cpus-per-task", m))?;
+    let partition = opts
+        .partition
+        .as_deref()
+        .map(|p| sbatch_value("partition", p))
+        .transpose()?;
+    let time = opts
+        .time
+        .as_deref()
+        .map(|t| sbatch_value("time", t))
+        .transpose()?;
+    let mut h = format!("#SBATCH --cpus-per-task={}\n", opts.cpus_per_task);
+    if let Some(p) = &partition {
+        h += &format!("#SBATCH --partition={p}\n");
+    }
+    if let Some(t) = &time {
+        h += &format!("#SBATCH --time={t}\n");
+    }
+    Ok(h)
+}
+
+/// Create `dir`'s `task`, `logs` and `shards` directories and copy the task there (under
+/// `task_file`'s name): the jobs read that copy. Its path.
+fn copy_task(dir: &Path, task_file: &Path, task_text: &str) -> Result<PathBuf, DistributeError> {
+    let shown = |e: std::io::Error, p: &Path| DistributeError::input(p, e.to_string());
+    let file_name = task_file
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .filter(|f| !f.is_empty())
+        .unwrap_or_else(|| "task.toml".into());
+    for sub in ["task", "logs", "shards"] {
+        let p = dir.join(sub);
+        std::fs::create_dir_all(&p).map_err(|e| shown(e, &p))?;
+    }
+    let task_copy = dir.join("task").join(&file_name);
+    std::fs::write(&task_copy, task_text).map_err(|e| shown(e, &task_copy))?;
+    Ok(task_copy)
+}
+
+/// The search's settings as `synthesize` flags (each with a leading space).
+fn search_settings(opts: &SlurmOptions) -> String {
+    let mut settings = String::new();
+    if let Some(k) = opts.n_max {
+        settings += &format!(" --n-max {k}");
+    }
+    settings += &format!(
+        " --starts {} --seed {} --sweep {}",
+        opts.starts, opts.seed, opts.sweep
+    );
+    if opts.rules != crate::grammar::Rules::default() {
+        settings += &format!(" --rules {}", opts.rules.names());
+    }
+    if opts.post_check_only {
+        settings += " --post-check-only";
+    }
+    settings
 }
 
 /// Run `sbatch ARGS`; the job id it prints with `--parsable` (`id` or `id;cluster`).

@@ -14,19 +14,40 @@
 //! what it may delete (only what an earlier run listed in its manifest) and when its
 //! records may be reused. A run can be one shard of the search ([`run_shard`]; see
 //! `distribute`).
+//!
+//! Each phase has its own file, in the order a run takes them: `options` (what they all
+//! share: settings, errors, an alternative, what an evaluation reports) → `plan` →
+//! `open` (the output directory) → `schedule` (the units on a pool, records streamed) →
+//! `evaluate` (one alternative; `measure`: what its judges look at) → `finish`
+//! (`readback` of the records, the summary) → `designs` → `report`; `run` calls them in
+//! that order.
 
+mod designs;
+mod evaluate;
+mod finish;
+mod measure;
+mod open;
+mod options;
 pub mod output;
 pub mod plan;
 mod progress;
+mod readback;
 mod record;
 mod report;
 mod run;
+mod schedule;
 
-pub use plan::Plan;
-pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
-pub use record::{AlternativeRecord, RankEntry, Summary, Tally, Timings, level_distribution};
-pub use run::{
+pub use designs::{model_meta, remeasure};
+pub use evaluate::prepare;
+pub use finish::finish;
+pub use open::{open_output, settings};
+pub use options::{
     Alternative, Evaluation, FailedModel, SHARD_REPORT, SHARD_TASK, SearchError, SearchOptions,
-    ShardReport, Share, check_search, evaluate_units, finish, model_meta, open_output, plan,
-    prepare, remeasure, run, run_shard, settings, tally_records,
+    ShardReport, Share, check_search,
 };
+pub use plan::{Plan, plan};
+pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
+pub use readback::tally_records;
+pub use record::{AlternativeRecord, RankEntry, Summary, Tally, Timings, level_distribution};
+pub use run::{run, run_shard};
+pub use schedule::evaluate_units;

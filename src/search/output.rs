@@ -148,6 +148,30 @@ impl RunSettings {
             })
             .collect()
     }
+
+    /// Whether `old` (an earlier run's settings file) holds these settings: `Err(why)`
+    /// when not, or when it is missing or unreadable.
+    fn same_as(&self, old: &Found<serde_json::Value>) -> Result<(), String> {
+        match old {
+            Found::Read(v) => {
+                let diff = self.differences(v);
+                if diff.is_empty() {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "it holds a run of other settings ({})",
+                        diff.join("; ")
+                    ))
+                }
+            }
+            Found::Missing => Err(format!(
+                "its {SETTINGS} is missing, so nothing shows which settings wrote its records"
+            )),
+            Found::Unreadable(e) => Err(format!(
+                "its {SETTINGS} is unreadable ({e}), so nothing shows which settings wrote its records"
+            )),
+        }
+    }
 }
 
 /// An error opening or writing the output directory.
@@ -176,6 +200,14 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
     move |source| OutputError::Io {
         path: path.display().to_string(),
         source,
+    }
+}
+
+/// The directory `shown` may not be used (without `--force`): why, and what to do.
+fn refused(shown: &str, message: String) -> OutputError {
+    OutputError::Refused {
+        path: shown.to_string(),
+        message,
     }
 }
 
@@ -287,10 +319,6 @@ impl OutputDir {
         force: bool,
     ) -> Result<Opened, OutputError> {
         let shown = root.display().to_string();
-        let refuse = |message: String| OutputError::Refused {
-            path: shown.clone(),
-            message,
-        };
         let mut notes = Vec::new();
         match fs::metadata(root) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
@@ -307,7 +335,8 @@ impl OutputDir {
             }
             Err(e) => return Err(io_err(root)(e)),
             Ok(m) if !m.is_dir() => {
-                return Err(refuse(
+                return Err(refused(
+                    &shown,
                     "is not a directory; --out takes a directory (it is created if missing)".into(),
                 ));
             }
@@ -330,51 +359,62 @@ impl OutputDir {
         let old_settings: Found<serde_json::Value> = read_json(&root.join(SETTINGS));
         let manifest = match manifest {
             Found::Read(m) if m.creator == "foldsynth" => m,
-            other => {
-                let why = match other {
-                    Found::Unreadable(e) => format!("its {MANIFEST} is unreadable ({e})"),
-                    _ => format!("it has no {MANIFEST}"),
-                };
-                if !force {
-                    return Err(refuse(format!(
-                        "not empty, and not a foldsynth run ({why}); foldsynth writes into an empty or new directory, or its own earlier run of the same settings. Give another --out, or --force to write into it anyway (nothing foldsynth did not write is deleted)"
-                    )));
-                }
-                notes.push(format!(
-                    "--force: writing into {shown}, which is not a foldsynth run ({why}); files foldsynth does not write are left as they are"
-                ));
-                if resume {
-                    notes.push(
-                        "--resume: no earlier run of these settings to resume; starting afresh"
-                            .into(),
-                    );
-                }
-                return Ok(Opened {
-                    dir: OutputDir::fresh(root)?,
-                    resume: false,
-                    notes,
-                });
-            }
+            other => return OutputDir::open_foreign(root, &other, resume, force, notes),
         };
-        let same = match &old_settings {
-            Found::Read(v) => {
-                let diff = settings.differences(v);
-                if diff.is_empty() {
-                    Ok(())
-                } else {
-                    Err(format!(
-                        "it holds a run of other settings ({})",
-                        diff.join("; ")
-                    ))
-                }
-            }
-            Found::Missing => Err(format!(
-                "its {SETTINGS} is missing, so nothing shows which settings wrote its records"
-            )),
-            Found::Unreadable(e) => Err(format!(
-                "its {SETTINGS} is unreadable ({e}), so nothing shows which settings wrote its records"
-            )),
+        let same = settings.same_as(&old_settings);
+        OutputDir::open_earlier(root, &manifest, same, resume, force, notes)
+    }
+
+    /// Open `root`, which is not empty and holds no foldsynth run (`manifest`: what was
+    /// found instead of its manifest): only with `force`, deleting nothing.
+    fn open_foreign(
+        root: &Path,
+        manifest: &Found<Manifest>,
+        resume: bool,
+        force: bool,
+        mut notes: Vec<String>,
+    ) -> Result<Opened, OutputError> {
+        let shown = root.display().to_string();
+        let why = match manifest {
+            Found::Unreadable(e) => format!("its {MANIFEST} is unreadable ({e})"),
+            _ => format!("it has no {MANIFEST}"),
         };
+        if !force {
+            return Err(refused(
+                &shown,
+                format!(
+                    "not empty, and not a foldsynth run ({why}); foldsynth writes into an empty or new directory, or its own earlier run of the same settings. Give another --out, or --force to write into it anyway (nothing foldsynth did not write is deleted)"
+                ),
+            ));
+        }
+        notes.push(format!(
+            "--force: writing into {shown}, which is not a foldsynth run ({why}); files foldsynth does not write are left as they are"
+        ));
+        if resume {
+            notes.push(
+                "--resume: no earlier run of these settings to resume; starting afresh".into(),
+            );
+        }
+        Ok(Opened {
+            dir: OutputDir::fresh(root)?,
+            resume: false,
+            notes,
+        })
+    }
+
+    /// Open `root`, which holds an earlier foldsynth run (its `manifest`) of the same
+    /// settings (`same`: `Err(why)` when not, or when nothing shows which): resumed or
+    /// replaced, deleting only the files the manifest lists; a run of other settings only
+    /// with `force`.
+    fn open_earlier(
+        root: &Path,
+        manifest: &Manifest,
+        same: Result<(), String>,
+        resume: bool,
+        force: bool,
+        mut notes: Vec<String>,
+    ) -> Result<Opened, OutputError> {
+        let shown = root.display().to_string();
         let dir = OutputDir {
             root: root.to_path_buf(),
             manifest: Mutex::new(Manifest::new()),
@@ -383,8 +423,8 @@ impl OutputDir {
             Ok(()) => {
                 // The same settings: an earlier run (or a killed one) of this very search.
                 let keep: &[&str] = if resume { &[RECORDS, SETTINGS] } else { &[] };
-                notes.extend(dir.remove_listed(&manifest, keep));
-                dir.adopt(&manifest, keep)?;
+                notes.extend(dir.remove_listed(manifest, keep));
+                dir.adopt(manifest, keep)?;
                 Ok(Opened { dir, resume, notes })
             }
             Err(why) if !force => {
@@ -393,15 +433,18 @@ impl OutputDir {
                 } else {
                     "a new run would replace it"
                 };
-                Err(refuse(format!(
-                    "{why}; {what}. Rerun with the settings it was written with, give another --out, or add --force to start afresh there (deleting only the files its {MANIFEST} lists)"
-                )))
+                Err(refused(
+                    &shown,
+                    format!(
+                        "{why}; {what}. Rerun with the settings it was written with, give another --out, or add --force to start afresh there (deleting only the files its {MANIFEST} lists)"
+                    ),
+                ))
             }
             Err(why) => {
                 notes.push(format!(
                     "--force: {shown}: {why}; deleting the files of that run and starting afresh"
                 ));
-                notes.extend(dir.remove_listed(&manifest, &[]));
+                notes.extend(dir.remove_listed(manifest, &[]));
                 dir.save()?;
                 Ok(Opened {
                     dir,

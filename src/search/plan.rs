@@ -9,7 +9,7 @@
 
 use std::time::Instant;
 
-use super::run::Alternative;
+use super::options::{Alternative, SearchError};
 use crate::export::plots::{NodeStatus, TreeNode};
 use crate::grammar::{CreaseGraph, Enumeration, Filters, Rules, Status};
 use crate::task::Task;
@@ -233,6 +233,20 @@ impl Plan {
     pub fn cost(&self, units: &[usize]) -> u64 {
         units.iter().map(|&u| self.units[u].cost).sum()
     }
+}
+
+/// The plan of `task`'s search at `n_max`; an error when there is nothing to search.
+pub fn plan(task: &Task, n_max: usize, rules: Rules) -> Result<Plan, SearchError> {
+    let plan = Plan::with_rules(task, n_max, rules);
+    if plan.graphs.is_empty() {
+        return Err(SearchError::Task {
+            task: task.name.clone(),
+            message: format!(
+                "G0 generates no meaningful graph up to N_max = {n_max} (see `foldsynth enumerate`): there is nothing to optimize"
+            ),
+        });
+    }
+    Ok(plan)
 }
 
 /// One bit per alternative: which are done.

@@ -2,8 +2,10 @@
 //! timings, the search tree, the distribution plot, and per feasible design its geometry,
 //! figures and files (the page itself is [`crate::export::report`]).
 
+use super::options::{SearchError, SearchOptions};
+use super::output::OutputDir;
+use super::progress::Progress;
 use super::record::{AlternativeRecord, LevelCounts, Summary};
-use super::run::SearchOptions;
 use crate::export::plots::{DistributionPlot, Series, TreeNode};
 use crate::export::report::{CountRow, Fact, ReportDesign, ReportInput, ReportSummary, TimingRow};
 use crate::export::{DesignMeta, Files, verify::VerifyReport};
@@ -11,6 +13,27 @@ use crate::grammar::VertexType;
 use crate::pattern::Pattern;
 use crate::task::Task;
 use std::path::PathBuf;
+
+/// Write `OUT/report.html` (always: its 3D views need only the geometry) from the summary
+/// `s`, the search tree and the designs' cards.
+pub(super) fn write_report(
+    task: &Task,
+    tree: Vec<TreeNode>,
+    s: &Summary,
+    opts: &SearchOptions,
+    out_dir: &OutputDir,
+    progress: &Progress,
+    cards: Vec<ReportDesign>,
+) -> Result<(), SearchError> {
+    progress.phase("write report", "", None);
+    let input = report_input(task, tree, s, task_facts(task, opts, s), cards);
+    out_dir.register([out_dir.path("report.html")])?;
+    let path = crate::export::report::write_report(out_dir.root(), &input)
+        .map_err(|e| SearchError::Export(e.to_string()))?;
+    let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    progress.finish_phase_with(&format!("{} ({bytes} bytes)", path.display()));
+    Ok(())
+}
 
 /// A number for the task table: at most 4 decimals, trailing zeros dropped.
 fn n4(x: f64) -> String {
@@ -30,7 +53,7 @@ fn angle(a: f64) -> String {
 
 /// The task as the run used it: G0, N_max, symmetry, motion, bounds, objective, checks,
 /// obstacles, and the search settings (starts, seed, sweep, workers, export).
-pub(super) fn task_facts(task: &Task, opts: &SearchOptions, s: &Summary) -> Vec<Fact> {
+fn task_facts(task: &Task, opts: &SearchOptions, s: &Summary) -> Vec<Fact> {
     let mut f = vec![Fact::new(
         "task",
         match &task.description {
@@ -41,6 +64,44 @@ pub(super) fn task_facts(task: &Task, opts: &SearchOptions, s: &Summary) -> Vec<
     if let Some(src) = &task.source {
         f.push(Fact::new("task file", src.display()));
     }
+    g0_facts(task, &mut f);
+    f.push(Fact::new(
+        "N_max",
+        format!(
+            "{} internal vertices at most ({} meaningful graphs)",
+            s.n_max, s.graphs
+        ),
+    ));
+    f.push(Fact::new(
+        "symmetry",
+        if task.symmetry.mirror_xz {
+            "mirror-symmetric about the xz-plane: mirror-image graphs are dropped"
+        } else {
+            "none"
+        },
+    ));
+    problem_facts(task, &mut f);
+    check_facts(task, &mut f);
+    f.push(Fact::new(
+        "search",
+        format!(
+            "{} starting points per alternative, seed {}, {} workers; rigidity and verification over {} states of the motion; {}",
+            opts.starts,
+            opts.seed,
+            s.settings["jobs"],
+            opts.sweep,
+            if opts.export {
+                "every feasible design exported (FOLD, SVG, OBJ, STL, pictures, GIF)"
+            } else {
+                "--no-export: design JSONs only, no per-design files"
+            }
+        ),
+    ));
+    f
+}
+
+/// G0's vertices and creases.
+fn g0_facts(task: &Task, f: &mut Vec<Fact>) {
     let g0 = &task.initial;
     f.push(Fact::new(
         "G0 vertices",
@@ -82,21 +143,10 @@ pub(super) fn task_facts(task: &Task, opts: &SearchOptions, s: &Summary) -> Vec<
             .collect::<Vec<_>>()
             .join("; "),
     ));
-    f.push(Fact::new(
-        "N_max",
-        format!(
-            "{} internal vertices at most ({} meaningful graphs)",
-            s.n_max, s.graphs
-        ),
-    ));
-    f.push(Fact::new(
-        "symmetry",
-        if task.symmetry.mirror_xz {
-            "mirror-symmetric about the xz-plane: mirror-image graphs are dropped"
-        } else {
-            "none"
-        },
-    ));
+}
+
+/// The motion, the bounds and the objective.
+fn problem_facts(task: &Task, f: &mut Vec<Fact>) {
     if let Some(m) = &task.motion {
         f.push(Fact::new(
             "motion",
@@ -141,6 +191,10 @@ pub(super) fn task_facts(task: &Task, opts: &SearchOptions, s: &Summary) -> Vec<
             ),
         ));
     }
+}
+
+/// The intersection check and the obstacles.
+fn check_facts(task: &Task, f: &mut Vec<Fact>) {
     if let Some(c) = &task.check {
         f.push(Fact::new(
             "intersection check",
@@ -166,22 +220,6 @@ pub(super) fn task_facts(task: &Task, opts: &SearchOptions, s: &Summary) -> Vec<
             ));
         }
     }
-    f.push(Fact::new(
-        "search",
-        format!(
-            "{} starting points per alternative, seed {}, {} workers; rigidity and verification over {} states of the motion; {}",
-            opts.starts,
-            opts.seed,
-            s.settings["jobs"],
-            opts.sweep,
-            if opts.export {
-                "every feasible design exported (FOLD, SVG, OBJ, STL, pictures, GIF)"
-            } else {
-                "--no-export: design JSONs only, no per-design files"
-            }
-        ),
-    ));
-    f
 }
 
 /// Per-design figures below the views: key, verification, variables.
@@ -287,7 +325,7 @@ pub(super) fn report_design(
 }
 
 /// The report's content.
-pub(super) fn report_input(
+fn report_input(
     task: &Task,
     tree: Vec<TreeNode>,
     s: &Summary,

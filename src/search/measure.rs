@@ -1,0 +1,97 @@
+//! What the judges of a design look at: the pattern they check (the arm, with its rotated
+//! copy for two-armed tasks), the task's obstacles, and the design's robustness measured
+//! by `check::robustness` (for a new design and for a recorded one alike).
+
+use crate::check::robustness::{self, RobustnessInput, RobustnessReport, UnitCreases};
+use crate::check::{Cylinder, two_armed};
+use crate::model::Model;
+use crate::pattern::Pattern;
+use crate::task::Task;
+
+/// The obstacles of the task as the checks take them.
+pub(super) fn obstacles(task: &Task) -> Vec<Cylinder> {
+    task.check
+        .as_ref()
+        .map(|c| c.cylinders.clone())
+        .unwrap_or_default()
+}
+
+/// The pattern checks and exports work on: the arm, with its rotated copy for two-armed
+/// tasks.
+pub(super) fn checked_pattern(task: &Task, arm: &Pattern) -> Result<Pattern, String> {
+    if task.check.as_ref().is_some_and(|c| c.second_arm) {
+        two_armed(arm).map_err(|e| e.to_string())
+    } else {
+        Ok(arm.clone())
+    }
+}
+
+/// The robustness of a design measured by `check::robustness` on the checked pattern
+/// (`pat`: the arm, or both arms) at the sweep's frames.
+pub(super) fn measure_robustness(
+    task: &Task,
+    model: &Model,
+    arm: &Pattern,
+    pat: &Pattern,
+) -> Result<RobustnessReport, String> {
+    let plan = &model.plan;
+    let face_names: Vec<String> = plan
+        .polygons
+        .iter()
+        .enumerate()
+        .filter(|(_, (p, _))| p.len() >= 3)
+        .map(|(f, _)| plan.facet_names[f].clone())
+        .collect();
+    let n = arm.vertices.len();
+    let vertex_names = (0..pat.vertices.len())
+        .map(|v| {
+            if v < n {
+                format!("v{}", plan.vertices[v].name)
+            } else {
+                format!("copy #{}", v - n + 1)
+            }
+        })
+        .collect();
+    let units = plan
+        .internal
+        .iter()
+        .map(|&a| {
+            let v = &plan.vertices[a];
+            let m = v.preds;
+            UnitCreases {
+                vertex: a,
+                ends: [0, 1, 2].map(|k| v.rays[m + k].other),
+                label: format!("v{}", v.name),
+            }
+        })
+        .collect();
+    let cylinders = obstacles(task);
+    // The arms of a two-armed gripper meet at a target on the rotation axis: their tips
+    // touch there by design (the copy of the gripping vertex is found by its flat position).
+    let tip = (pat.vertices.len() > n
+        && model
+            .targets
+            .iter()
+            .any(|t| t.point[0].abs() < 1e-9 && t.point[1].abs() < 1e-9))
+    .then(|| {
+        let g = model.gripping;
+        let q = [-arm.vertices[g][0], -arm.vertices[g][1]];
+        (n..pat.vertices.len())
+            .find(|&j| (pat.vertices[j][0] - q[0]).hypot(pat.vertices[j][1] - q[1]) <= 1e-9)
+            .map(|c| (g, c))
+    })
+    .flatten();
+    let input = RobustnessInput {
+        pattern: pat,
+        arm_faces: arm.faces.len(),
+        face_names,
+        vertex_names,
+        cylinders: &cylinders,
+        units,
+        tip,
+        t_max: model.t_max,
+        settings: task.robustness,
+        arm,
+    };
+    robustness::measure(&input).map_err(|e| e.to_string())
+}
