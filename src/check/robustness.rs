@@ -32,7 +32,7 @@ use super::cylinder::Cylinder;
 use super::features::{self, FeatureKind};
 use super::self_intersection::{CheckError, Checker};
 use super::tri_tri::{Tri, triangles_intersect};
-use crate::pattern::Pattern;
+use crate::pattern::{Frame, Pattern};
 use crate::task::{DEFAULT_CLEARANCE, DEFAULT_MIN_FEATURE, DEFAULT_RIGID_MARGIN, Robustness};
 
 type V = Vector3<f64>;
@@ -174,9 +174,84 @@ impl Least {
 pub fn measure(input: &RobustnessInput<'_>) -> Result<RobustnessReport, CheckError> {
     let pat = input.pattern;
     let checker = Checker::from_pattern(pat)?;
-    let tris = checker.triangles();
-    let nf = pat.faces.len();
-    let face_name = |f: usize| {
+    let names = Names { input };
+    let pairs = face_pairs(input, &checker);
+    let mut least = Leasts {
+        rigid: Least::new(),
+        own: Least::new(),
+        arm: Least::new(),
+        obstacle: Least::new(),
+    };
+    // From the end of the motion, where the pattern is most folded: the least values are
+    // found early and prune more of the rest. Pruning only skips what is provably above
+    // the least value so far (strictly, with slack for rounding), so the report is the
+    // one a full evaluation gives.
+    for frame in pat.frames.iter().rev() {
+        let t = frame.t;
+        checker.validate_state(&frame.coords, t)?;
+        let x: Vec<V> = frame.coords.iter().map(|c| V::from(*c)).collect();
+        if t != 0.0 {
+            rigid_margins(&input.units, input.t_max, &x, t, &mut least.rigid);
+        }
+        let state = State::new(input, &checker, &names, frame, x);
+        for &(fa, fb, rel) in &pairs {
+            let least = if fb < input.arm_faces {
+                &mut least.own
+            } else {
+                &mut least.arm
+            };
+            state.pair_clearance(fa, fb, rel, least);
+        }
+        state.obstacle_clearances(input.cylinders, &mut least.obstacle);
+    }
+    Ok(report(input, least, &names))
+}
+
+/// The least values of the sweep so far.
+struct Leasts {
+    rigid: Least,
+    /// Arm–arm face pairs.
+    own: Least,
+    /// Arm–copy face pairs.
+    arm: Least,
+    obstacle: Least,
+}
+
+/// The report of the least values found, scored.
+fn report(input: &RobustnessInput<'_>, least: Leasts, names: &Names<'_, '_>) -> RobustnessReport {
+    let s = &input.settings;
+    let rigid_margin = least.rigid.report(s.rigid_margin).unwrap_or(MarginReport {
+        value: f64::INFINITY,
+        setting: s.rigid_margin,
+        t: None,
+        location: "no internal vertex".into(),
+    });
+    let mut report = RobustnessReport {
+        score: 0.0,
+        rigid_margin,
+        self_clearance: least.own.report(s.clearance),
+        arm_clearance: least.arm.report(s.clearance),
+        obstacle_clearance: least.obstacle.report(s.obstacle_clearance),
+        min_feature: features::pattern_min_feature(input.arm).map(|f| MarginReport {
+            value: f.value,
+            setting: s.min_feature,
+            t: Some(0.0),
+            location: feature_location(&f.kind, |v| names.vertex(v)),
+        }),
+    };
+    report.score = score(&report);
+    report
+}
+
+/// The names of faces and vertices in reports (`#k` where the input has none).
+struct Names<'a, 'b> {
+    input: &'a RobustnessInput<'b>,
+}
+
+impl Names<'_, '_> {
+    /// Face `f`'s name; a copy's gets a prime.
+    fn face(&self, f: usize) -> String {
+        let input = self.input;
         if f < input.arm_faces {
             input.face_names.get(f).cloned().unwrap_or(format!("#{f}"))
         } else {
@@ -189,16 +264,23 @@ pub fn measure(input: &RobustnessInput<'_>) -> Result<RobustnessReport, CheckErr
                     .unwrap_or(format!("#{f}"))
             )
         }
-    };
-    let vname = |v: usize| {
-        input
+    }
+
+    /// Vertex `v`'s name.
+    fn vertex(&self, v: usize) -> String {
+        self.input
             .vertex_names
             .get(v)
             .cloned()
             .unwrap_or(format!("#{v}"))
-    };
-    // Relations of the face pairs that count: arm–arm and arm–copy (copy–copy pairs are
-    // arm–arm pairs turned by 180°).
+    }
+}
+
+/// Relations of the face pairs that count: arm–arm and arm–copy (copy–copy pairs are
+/// arm–arm pairs turned by 180°).
+fn face_pairs(input: &RobustnessInput<'_>, checker: &Checker) -> Vec<(usize, usize, Relation)> {
+    let pat = input.pattern;
+    let nf = pat.faces.len();
     let mut pairs: Vec<(usize, usize, Relation)> = Vec::new();
     for fa in 0..input.arm_faces.min(nf) {
         for fb in fa + 1..nf {
@@ -228,31 +310,44 @@ pub fn measure(input: &RobustnessInput<'_>) -> Result<RobustnessReport, CheckErr
             pairs.push((fa, fb, rel));
         }
     }
-    let mut rigid = Least::new();
-    let mut own = Least::new();
-    let mut arm = Least::new();
-    let mut obstacle = Least::new();
-    // From the end of the motion, where the pattern is most folded: the least values are
-    // found early and prune more of the rest. Pruning only skips what is provably above
-    // the least value so far (strictly, with slack for rounding), so the report is the
-    // one a full evaluation gives.
-    for frame in pat.frames.iter().rev() {
-        let t = frame.t;
-        checker.validate_state(&frame.coords, t)?;
-        let x: Vec<V> = frame.coords.iter().map(|c| V::from(*c)).collect();
-        // Rigid margins from the folded crease directions.
-        if t != 0.0 {
-            let scale = (input.t_max / t).powi(2);
-            for u in &input.units {
-                let d = u.ends.map(|e| x[e] - x[u.vertex]);
-                let ang = |p: &V, q: &V| p.cross(q).norm().atan2(p.dot(q));
-                let (u1, u2, u3) = (ang(&d[2], &d[0]), ang(&d[0], &d[1]), ang(&d[1], &d[2]));
-                let m = (u2 + u3 - u1).min(u1 + u3 - u2).min(u1 + u2 - u3);
-                rigid.offer(m * scale, t, || u.label.clone());
-            }
-        }
-        // Bounding spheres of the faces for the pruning of far pairs.
-        let spheres: Vec<(V, f64)> = pat
+    pairs
+}
+
+/// Rigid margins from the folded crease directions at state `t` (positions `x`),
+/// normalized by `(t/t_max)²`.
+fn rigid_margins(units: &[UnitCreases], t_max: f64, x: &[V], t: f64, rigid: &mut Least) {
+    let scale = (t_max / t).powi(2);
+    for u in units {
+        let d = u.ends.map(|e| x[e] - x[u.vertex]);
+        let ang = |p: &V, q: &V| p.cross(q).norm().atan2(p.dot(q));
+        let (u1, u2, u3) = (ang(&d[2], &d[0]), ang(&d[0], &d[1]), ang(&d[1], &d[2]));
+        let m = (u2 + u3 - u1).min(u1 + u3 - u2).min(u1 + u2 - u3);
+        rigid.offer(m * scale, t, || u.label.clone());
+    }
+}
+
+/// One state of the sweep: the positions, and the bounding spheres of the faces and
+/// triangles for the pruning of far pairs.
+struct State<'a> {
+    input: &'a RobustnessInput<'a>,
+    checker: &'a Checker,
+    names: &'a Names<'a, 'a>,
+    frame: &'a Frame,
+    x: Vec<V>,
+    spheres: Vec<(V, f64)>,
+    tri_spheres: Vec<Vec<(V, f64)>>,
+}
+
+impl<'a> State<'a> {
+    fn new(
+        input: &'a RobustnessInput<'a>,
+        checker: &'a Checker,
+        names: &'a Names<'a, 'a>,
+        frame: &'a Frame,
+        x: Vec<V>,
+    ) -> State<'a> {
+        let spheres: Vec<(V, f64)> = input
+            .pattern
             .faces
             .iter()
             .map(|f| {
@@ -261,134 +356,126 @@ pub fn measure(input: &RobustnessInput<'_>) -> Result<RobustnessReport, CheckErr
                 (c, r)
             })
             .collect();
-        let tri = |ix: &[usize; 3]| -> Tri { ix.map(|i| x[i]) };
-        let tri_spheres: Vec<Vec<(V, f64)>> = tris
+        let tri_spheres: Vec<Vec<(V, f64)>> = checker
+            .triangles()
             .iter()
-            .map(|ts| ts.iter().map(|ix| bounding_sphere(&tri(ix))).collect())
+            .map(|ts| {
+                ts.iter()
+                    .map(|ix| bounding_sphere(&ix.map(|i| x[i])))
+                    .collect()
+            })
             .collect();
-        for &(fa, fb, rel) in &pairs {
-            let least = if fb < input.arm_faces {
-                &mut own
-            } else {
-                &mut arm
-            };
-            match rel {
-                Relation::Apart => {
-                    if apart_beyond(spheres[fa], spheres[fb], least.value) {
-                        continue;
-                    }
-                    let mut d = f64::INFINITY;
-                    for (a, sa) in tris[fa].iter().zip(&tri_spheres[fa]) {
-                        for (b, sb) in tris[fb].iter().zip(&tri_spheres[fb]) {
-                            if !apart_beyond(*sa, *sb, d.min(least.value)) {
-                                d = d.min(triangle_distance(&tri(a), &tri(b)));
-                            }
+        State {
+            input,
+            checker,
+            names,
+            frame,
+            x,
+            spheres,
+            tri_spheres,
+        }
+    }
+
+    fn tri(&self, ix: &[usize; 3]) -> Tri {
+        ix.map(|i| self.x[i])
+    }
+
+    /// Offer the clearance of faces `fa` and `fb` (related by `rel`) to `least`, unless it
+    /// is provably above the least value so far.
+    fn pair_clearance(&self, fa: usize, fb: usize, rel: Relation, least: &mut Least) {
+        let (t, x, faces) = (self.frame.t, &self.x, &self.input.pattern.faces);
+        let pair = || format!("facets {}–{}", self.names.face(fa), self.names.face(fb));
+        match rel {
+            Relation::Apart => {
+                if apart_beyond(self.spheres[fa], self.spheres[fb], least.value) {
+                    return;
+                }
+                let tris = self.checker.triangles();
+                let mut d = f64::INFINITY;
+                for (a, sa) in tris[fa].iter().zip(&self.tri_spheres[fa]) {
+                    for (b, sb) in tris[fb].iter().zip(&self.tri_spheres[fb]) {
+                        if !apart_beyond(*sa, *sb, d.min(least.value)) {
+                            d = d.min(triangle_distance(&self.tri(a), &self.tri(b)));
                         }
                     }
-                    least.offer(d, t, || {
-                        format!("facets {}–{}", face_name(fa), face_name(fb))
-                    });
                 }
-                Relation::Wedge(v) => {
-                    let Some(theta) = cone_angle_below(
-                        x[v],
-                        &pat.faces[fa],
-                        &pat.faces[fb],
-                        &x,
-                        chord_angle(least.value),
-                    ) else {
-                        continue;
-                    };
-                    let chord = 2.0 * (0.5 * theta).sin();
-                    least.offer(chord, t, || {
-                        format!("facets {}–{} at {}", face_name(fa), face_name(fb), vname(v))
-                    });
-                }
-                Relation::Tip => {
-                    let (g, c) = input.tip.expect("tip pairs need the tips");
-                    // The tips are the apex (within the target's tolerance of it): the
-                    // cones are those of the faces' other vertices.
-                    let other = |f: usize| -> Vec<usize> {
-                        pat.faces[f]
-                            .iter()
-                            .copied()
-                            .filter(|v| *v != g && *v != c)
-                            .collect()
-                    };
-                    let Some(theta) = cone_angle_below(
-                        (x[g] + x[c]) * 0.5,
-                        &other(fa),
-                        &other(fb),
-                        &x,
-                        chord_angle(least.value),
-                    ) else {
-                        continue;
-                    };
-                    let chord = 2.0 * (0.5 * theta).sin();
-                    least.offer(chord, t, || {
-                        format!("facets {}–{} at the tips", face_name(fa), face_name(fb))
-                    });
-                }
-                Relation::Crease(h) => {
-                    let hinge = &checker.hinges()[h];
-                    let rho = hinge.fold_angle(&frame.coords);
-                    let chord = 2.0 * (0.5 * (std::f64::consts::PI - rho.abs())).sin();
-                    least.offer(chord, t, || {
-                        format!(
-                            "crease {}–{} between facets {}–{}",
-                            vname(hinge.p),
-                            vname(hinge.q),
-                            face_name(fa),
-                            face_name(fb)
-                        )
-                    });
-                }
+                least.offer(d, t, pair);
             }
-        }
-        for (k, cyl) in input.cylinders.iter().enumerate() {
-            let (a, b) = (V::from(cyl.a), V::from(cyl.b));
-            let beyond = |(c, r): (V, f64), limit: f64| {
-                point_segment_distance(&c, &a, &b) - r - cyl.radius - SLACK > limit
-            };
-            for (f, ts) in tris.iter().enumerate() {
-                if beyond(spheres[f], obstacle.value) {
-                    continue;
-                }
-                let mut d = f64::INFINITY;
-                for (ix, sph) in ts.iter().zip(&tri_spheres[f]) {
-                    if !beyond(*sph, (d - cyl.radius).min(obstacle.value)) {
-                        d = d.min(segment_triangle_distance(&a, &b, &tri(ix)));
-                    }
-                }
-                let d = d - cyl.radius;
-                obstacle.offer(d, t, || {
-                    format!("facet {} ↔ cylinder {}", face_name(f), k + 1)
+            Relation::Wedge(v) => {
+                let Some(theta) =
+                    cone_angle_below(x[v], &faces[fa], &faces[fb], x, chord_angle(least.value))
+                else {
+                    return;
+                };
+                let chord = 2.0 * (0.5 * theta).sin();
+                least.offer(chord, t, || {
+                    format!("{} at {}", pair(), self.names.vertex(v))
+                });
+            }
+            Relation::Tip => {
+                let (g, c) = self.input.tip.expect("tip pairs need the tips");
+                // The tips are the apex (within the target's tolerance of it): the
+                // cones are those of the faces' other vertices.
+                let other = |f: usize| -> Vec<usize> {
+                    faces[f]
+                        .iter()
+                        .copied()
+                        .filter(|v| *v != g && *v != c)
+                        .collect()
+                };
+                let Some(theta) = cone_angle_below(
+                    (x[g] + x[c]) * 0.5,
+                    &other(fa),
+                    &other(fb),
+                    x,
+                    chord_angle(least.value),
+                ) else {
+                    return;
+                };
+                let chord = 2.0 * (0.5 * theta).sin();
+                least.offer(chord, t, || format!("{} at the tips", pair()));
+            }
+            Relation::Crease(h) => {
+                let hinge = &self.checker.hinges()[h];
+                let rho = hinge.fold_angle(&self.frame.coords);
+                let chord = 2.0 * (0.5 * (std::f64::consts::PI - rho.abs())).sin();
+                least.offer(chord, t, || {
+                    format!(
+                        "crease {}–{} between {}",
+                        self.names.vertex(hinge.p),
+                        self.names.vertex(hinge.q),
+                        pair()
+                    )
                 });
             }
         }
     }
-    let s = &input.settings;
-    let rigid_margin = rigid.report(s.rigid_margin).unwrap_or(MarginReport {
-        value: f64::INFINITY,
-        setting: s.rigid_margin,
-        t: None,
-        location: "no internal vertex".into(),
-    });
-    let mut report = RobustnessReport {
-        score: 0.0,
-        rigid_margin,
-        self_clearance: own.report(s.clearance),
-        arm_clearance: arm.report(s.clearance),
-        obstacle_clearance: obstacle.report(s.obstacle_clearance),
-        min_feature: features::pattern_min_feature(input.arm).map(|f| MarginReport {
-            value: f.value,
-            setting: s.min_feature,
-            t: Some(0.0),
-            location: feature_location(&f.kind, vname),
-        }),
-    };
-    report.score = score(&report);
-    Ok(report)
+
+    /// Offer the clearance of every face to every cylinder to `obstacle`.
+    fn obstacle_clearances(&self, cylinders: &[Cylinder], obstacle: &mut Least) {
+        let t = self.frame.t;
+        for (k, cyl) in cylinders.iter().enumerate() {
+            let (a, b) = (V::from(cyl.a), V::from(cyl.b));
+            let beyond = |(c, r): (V, f64), limit: f64| {
+                point_segment_distance(&c, &a, &b) - r - cyl.radius - SLACK > limit
+            };
+            for (f, ts) in self.checker.triangles().iter().enumerate() {
+                if beyond(self.spheres[f], obstacle.value) {
+                    continue;
+                }
+                let mut d = f64::INFINITY;
+                for (ix, sph) in ts.iter().zip(&self.tri_spheres[f]) {
+                    if !beyond(*sph, (d - cyl.radius).min(obstacle.value)) {
+                        d = d.min(segment_triangle_distance(&a, &b, &self.tri(ix)));
+                    }
+                }
+                let d = d - cyl.radius;
+                obstacle.offer(d, t, || {
+                    format!("facet {} ↔ cylinder {}", self.names.face(f), k + 1)
+                });
+            }
+        }
+    }
 }
 
 /// Where a feature is, with the vertices' names: `"v3 ↔ v7"`, `"edge v2–v5"`,

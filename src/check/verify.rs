@@ -13,7 +13,8 @@
 
 use crate::geom;
 use crate::kinematics::{closure_residual, wrap_angle};
-use crate::model::geometry::{Folded, units};
+use crate::model::Plan;
+use crate::model::geometry::{Flat, Folded, units};
 use crate::model::numeric::Evaluated;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -149,7 +150,7 @@ pub fn verify_folded(
     let mut r = VerifyReport {
         isometry_max: 0.0,
         closure_max: 0.0,
-        developability_max: 0.0,
+        developability_max: developability(plan, flat),
         fold_angle_max: 0.0,
         rigid_over_motion: true,
         rigid_at_tmax: true,
@@ -158,8 +159,50 @@ pub fn verify_folded(
         states: ts.len(),
         rigid_states: 0,
     };
+    let flat3: Vec<[f64; 3]> = flat.pos.iter().map(|p| [p[0], p[1], 0.0]).collect();
+    // Facets whose flat normal is −z (the same at every state).
+    let flat_reversed: Vec<bool> = plan
+        .polygons
+        .iter()
+        .map(|(p, _)| {
+            geom::newell_normal(&p.iter().map(|v| flat3[*v]).collect::<Vec<_>>())[2] < 0.0
+        })
+        .collect();
+    for (si, (&t, folded)) in ts.iter().zip(folds).enumerate() {
+        // Rigidity first: the geometry of a state is only defined where every vertex is.
+        let (rigid, state_margin) = rigidity(plan, folded, t, tol, &mut r);
+        if !rigid {
+            r.rigid_over_motion = false;
+            if si + 1 == ts.len() {
+                r.rigid_at_tmax = false;
+            }
+            continue;
+        }
+        if state_margin < tol.geometry_margin {
+            continue;
+        }
+        r.rigid_states += 1;
+        let x = design.coords(folded);
+        isometry(plan, &flat3, &x, &mut r.isometry_max);
+        // Closure at every internal vertex.
+        let rho: Vec<Option<f64>> = folded.rho.iter().map(|x| Some(*x)).collect();
+        for &a in &plan.internal {
+            let st = folded.states[a]
+                .as_ref()
+                .expect("internal vertices are solved");
+            if let Some(u) = units(plan, flat, &rho, a) {
+                r.closure_max = r.closure_max.max(closure_residual(&u, &st.phi));
+            }
+        }
+        fold_angles(plan, &flat_reversed, folded, &x, &mut r.fold_angle_max);
+    }
+    r
+}
 
-    // Developability on the flat coordinates.
+/// The worst deviation of the angles between consecutive creases on the flat
+/// coordinates from the model's sectors, or of their sum from 2π, at every internal vertex.
+fn developability(plan: &Plan, flat: &Flat<f64>) -> f64 {
+    let mut worst = 0.0f64;
     for (i, v) in plan.vertices.iter().enumerate() {
         if !v.internal {
             continue;
@@ -178,99 +221,90 @@ pub fn verify_folded(
                 ang += 2.0 * PI;
             }
             sum += ang;
-            r.developability_max = r.developability_max.max((ang - flat.sectors[i][k]).abs());
+            worst = worst.max((ang - flat.sectors[i][k]).abs());
         }
-        r.developability_max = r.developability_max.max((sum - 2.0 * PI).abs());
+        worst = worst.max((sum - 2.0 * PI).abs());
     }
+    worst
+}
 
-    let flat3: Vec<[f64; 3]> = flat.pos.iter().map(|p| [p[0], p[1], 0.0]).collect();
-    // Facets whose flat normal is −z (the same at every state).
-    let flat_reversed: Vec<bool> = plan
+/// Whether every internal vertex of the state `folded` at `t` is rigid, and its smallest
+/// margin; the report's least margin is updated on the way.
+fn rigidity(
+    plan: &Plan,
+    folded: &Folded<f64>,
+    t: f64,
+    tol: &Tolerances,
+    r: &mut VerifyReport,
+) -> (bool, f64) {
+    let mut rigid = true;
+    let mut state_margin = f64::INFINITY;
+    for &a in &plan.internal {
+        let st = folded.states[a]
+            .as_ref()
+            .expect("internal vertices are solved");
+        let margin = st.margins.iter().copied().fold(f64::INFINITY, f64::min);
+        if margin < r.min_margin {
+            r.min_margin = margin;
+            r.min_margin_t = t;
+        }
+        if margin < -tol.margin {
+            rigid = false;
+        }
+        state_margin = state_margin.min(margin);
+    }
+    (rigid, state_margin)
+}
+
+/// Isometry at positions `x`: every facet's pairwise vertex distances against the flat
+/// ones (`flat3`), relative to the facet's size; the worst into `worst`.
+fn isometry(plan: &Plan, flat3: &[[f64; 3]], x: &[[f64; 3]], worst: &mut f64) {
+    for (poly, _) in &plan.polygons {
+        let size = poly
+            .iter()
+            .flat_map(|a| poly.iter().map(move |b| (a, b)))
+            .map(|(a, b)| geom::dist(flat3[*a], flat3[*b]))
+            .fold(0.0, f64::max);
+        for (ia, a) in poly.iter().enumerate() {
+            for b in &poly[ia + 1..] {
+                let e = (geom::dist(x[*a], x[*b]) - geom::dist(flat3[*a], flat3[*b])).abs()
+                    / size.max(1e-300);
+                *worst = worst.max(e);
+            }
+        }
+    }
+}
+
+/// Fold angles against the facets' normals (`geom::fold_angle`) at positions `x`, each
+/// facet's points ordered so its flat normal is +z (`flat_reversed`: an inverted facet is
+/// a layout defect the intersection check reports, not a wrong fold angle); the worst
+/// disagreement into `worst`.
+fn fold_angles(
+    plan: &Plan,
+    flat_reversed: &[bool],
+    folded: &Folded<f64>,
+    x: &[[f64; 3]],
+    worst: &mut f64,
+) {
+    let facet_points: Vec<Vec<[f64; 3]>> = plan
         .polygons
         .iter()
-        .map(|(p, _)| {
-            geom::newell_normal(&p.iter().map(|v| flat3[*v]).collect::<Vec<_>>())[2] < 0.0
+        .zip(flat_reversed)
+        .map(|((p, _), &reversed)| {
+            let mut pts: Vec<[f64; 3]> = p.iter().map(|v| x[*v]).collect();
+            if reversed {
+                pts.reverse();
+            }
+            pts
         })
         .collect();
-    for (si, (&t, folded)) in ts.iter().zip(folds).enumerate() {
-        // Rigidity first: the geometry of a state is only defined where every vertex is.
-        let mut rigid = true;
-        let mut state_margin = f64::INFINITY;
-        for &a in &plan.internal {
-            let st = folded.states[a]
-                .as_ref()
-                .expect("internal vertices are solved");
-            let margin = st.margins.iter().copied().fold(f64::INFINITY, f64::min);
-            if margin < r.min_margin {
-                r.min_margin = margin;
-                r.min_margin_t = t;
-            }
-            if margin < -tol.margin {
-                rigid = false;
-            }
-            state_margin = state_margin.min(margin);
-        }
-        if !rigid {
-            r.rigid_over_motion = false;
-            if si + 1 == ts.len() {
-                r.rigid_at_tmax = false;
-            }
+    for (ci, c) in plan.creases.iter().enumerate() {
+        let (l, rt) = (&facet_points[c.left], &facet_points[c.right]);
+        if l.len() < 3 || rt.len() < 3 {
             continue;
         }
-        if state_margin < tol.geometry_margin {
-            continue;
-        }
-        r.rigid_states += 1;
-        let x = design.coords(folded);
-        // Isometry, relative to each facet's size.
-        for (poly, _) in &plan.polygons {
-            let size = poly
-                .iter()
-                .flat_map(|a| poly.iter().map(move |b| (a, b)))
-                .map(|(a, b)| geom::dist(flat3[*a], flat3[*b]))
-                .fold(0.0, f64::max);
-            for (ia, a) in poly.iter().enumerate() {
-                for b in &poly[ia + 1..] {
-                    let e = (geom::dist(x[*a], x[*b]) - geom::dist(flat3[*a], flat3[*b])).abs()
-                        / size.max(1e-300);
-                    r.isometry_max = r.isometry_max.max(e);
-                }
-            }
-        }
-        // Closure at every internal vertex.
-        let rho: Vec<Option<f64>> = folded.rho.iter().map(|x| Some(*x)).collect();
-        for &a in &plan.internal {
-            let st = folded.states[a]
-                .as_ref()
-                .expect("internal vertices are solved");
-            if let Some(u) = units(plan, flat, &rho, a) {
-                r.closure_max = r.closure_max.max(closure_residual(&u, &st.phi));
-            }
-        }
-        // Fold angles against the facets' normals (`geom::fold_angle`), each facet's points
-        // ordered so its flat normal is +z (an inverted facet is a layout defect the
-        // intersection check reports, not a wrong fold angle).
-        let facet_points: Vec<Vec<[f64; 3]>> = plan
-            .polygons
-            .iter()
-            .zip(&flat_reversed)
-            .map(|((p, _), &reversed)| {
-                let mut pts: Vec<[f64; 3]> = p.iter().map(|v| x[*v]).collect();
-                if reversed {
-                    pts.reverse();
-                }
-                pts
-            })
-            .collect();
-        for (ci, c) in plan.creases.iter().enumerate() {
-            let (l, rt) = (&facet_points[c.left], &facet_points[c.right]);
-            if l.len() < 3 || rt.len() < 3 {
-                continue;
-            }
-            if let Some(geo) = geom::fold_angle(x[c.tail], x[c.head], l, rt) {
-                r.fold_angle_max = r.fold_angle_max.max(wrap_angle(geo - folded.rho[ci]).abs());
-            }
+        if let Some(geo) = geom::fold_angle(x[c.tail], x[c.head], l, rt) {
+            *worst = worst.max(wrap_angle(geo - folded.rho[ci]).abs());
         }
     }
-    r
 }

@@ -23,10 +23,10 @@ use crate::trig::{self, Ops};
 use cranelift_codegen::Context;
 use cranelift_codegen::ir::condcodes::FloatCC;
 use cranelift_codegen::ir::{
-    AbiParam, BlockArg, FuncRef, InstBuilder, MemFlagsData, Signature, StackSlotData,
+    AbiParam, BlockArg, FuncRef, InstBuilder, MemFlagsData, Signature, StackSlot, StackSlotData,
     StackSlotKind, UserFuncName, Value, types,
 };
-use cranelift_codegen::isa::OwnedTargetIsa;
+use cranelift_codegen::isa::{OwnedTargetIsa, TargetFrontendConfig};
 use cranelift_codegen::settings::{self, Configurable};
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext};
 use cranelift_module::{FuncId, Linkage, Module};
@@ -245,6 +245,25 @@ impl Batch {
     fn len(&self) -> usize {
         3 * self.sc.len() + 3 * self.at.len() + 2 * self.ac.len()
     }
+
+    /// The arguments the call reads, each with its f64 offset in the group's buffer:
+    /// the sin/cos arguments, atan2's `y`s, atan2's `x`s, acos's arguments.
+    fn stores(&self, nodes: &[Node]) -> Vec<(NodeId, usize)> {
+        let (nsc, nat) = (self.sc.len(), self.at.len());
+        let mut stores: Vec<(NodeId, usize)> = Vec::new();
+        for (k, &a) in self.sc.iter().enumerate() {
+            stores.push((a, k));
+        }
+        for (k, &i) in self.at.iter().enumerate() {
+            let [y, x] = [0, 1].map(|j| nodes[i].children().as_slice()[j]);
+            stores.push((y, nsc + k));
+            stores.push((x, nsc + nat + k));
+        }
+        for (k, &i) in self.ac.iter().enumerate() {
+            stores.push((nodes[i].children().as_slice()[0], nsc + 2 * nat + k));
+        }
+        stores
+    }
 }
 
 /// Where a node's value comes from.
@@ -268,137 +287,108 @@ enum Source {
 /// the code ran as fast at 64 and 256 as without, ~15 % slower at 16.
 const SPILL_WINDOW: usize = 64;
 
-/// Define `name` in `module`: the function computing `outputs` of `graph` (`mark`: the
-/// nodes they reach, from [`crate::expr::check_indices`]) with transcendentals by `mode`.
-///
-/// Where the ISA has fused multiply-add, a sum or difference at node index `fuse_from` or
-/// above whose operand is a product used nowhere else becomes one `fma` (one rounding
-/// instead of two, and one instruction: the gradients [`super::compile`] appends are
-/// mostly sums of products). Nodes below `fuse_from` round as the interpreter does, bit
-/// for bit; `usize::MAX` fuses nothing.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn define_eval<M: Module>(
-    module: &mut M,
-    name: &str,
-    linkage: Linkage,
-    graph: &ExprGraph,
-    outputs: &[NodeId],
-    mark: &[bool],
-    mode: Math,
-    fuse_from: usize,
-) -> Result<Built, CompileError> {
-    let ptr = module.target_config().pointer_type();
-    let mut sig = module.make_signature();
-    for _ in 0..3 {
-        sig.params.push(AbiParam::new(ptr));
-    }
-    let func_id = module.declare_function(name, linkage, &sig).map_err(cg)?;
-    let nodes = graph.nodes();
-
-    // Math::Batch: group the transcendentals by depth (how many transcendentals lie on
-    // the deepest path below them): a group's arguments only need smaller depths.
+/// The transcendentals of the reachable nodes grouped for [`Math::Batch`] by depth (how
+/// many transcendentals lie on the deepest path below them): a group's arguments only need
+/// smaller depths. Returns every node's depth and the groups, laid out one after the other
+/// in the batch slot.
+fn group_by_depth(nodes: &[Node], mark: &[bool]) -> (Vec<u32>, Vec<Batch>) {
     let mut depth = vec![0u32; nodes.len()];
     let mut batches: Vec<Batch> = Vec::new();
-    if mode == Math::Batch {
-        for (i, n) in nodes.iter().enumerate() {
-            if mark[i] {
-                depth[i] = n
-                    .children()
-                    .into_iter()
-                    .map(|c| depth[c.index()] + u32::from(is_trig(&nodes[c.index()])))
-                    .max()
-                    .unwrap_or(0);
-            }
-        }
-        let mut seen: FxHashMap<(u32, NodeId), ()> = FxHashMap::default();
-        for (i, n) in nodes.iter().enumerate() {
-            if !mark[i] || !is_trig(n) {
-                continue;
-            }
-            let d = depth[i] as usize;
-            if batches.len() <= d {
-                batches.resize_with(d + 1, Batch::default);
-            }
-            match *n {
-                Node::Sin(a) | Node::Cos(a) => {
-                    if seen.insert((d as u32, a), ()).is_none() {
-                        batches[d].sc.push(a);
-                    }
-                }
-                Node::Atan2(..) => batches[d].at.push(i),
-                _ => batches[d].ac.push(i),
-            }
-        }
-        let mut base = 0u32;
-        for bt in &mut batches {
-            bt.base = base;
-            base += bt.len() as u32;
+    for (i, n) in nodes.iter().enumerate() {
+        if mark[i] {
+            depth[i] = n
+                .children()
+                .into_iter()
+                .map(|c| depth[c.index()] + u32::from(is_trig(&nodes[c.index()])))
+                .max()
+                .unwrap_or(0);
         }
     }
-    let slot_len: u32 = batches.iter().map(|b| b.len() as u32).sum();
-    let fused = fusable_products(
-        graph,
-        outputs,
-        mark,
-        fuse_from,
-        module.isa().has_native_fma(),
-    );
-
-    let mut ctx: Context = module.make_context();
-    ctx.func.signature = sig;
-    ctx.func.name = UserFuncName::user(0, func_id.as_u32());
-    let mut fctx = FunctionBuilderContext::new();
-    let target = module.target_config();
-    let mut n_inst = 0usize;
-    let mut n_calls = 0usize;
-    let n_spilled;
-    {
-        let mut b = FunctionBuilder::new(&mut ctx.func, &mut fctx);
-        let block = b.create_block();
-        b.append_block_params_for_function_params(block);
-        b.switch_to_block(block);
-        let p = b.block_params(block).to_vec();
-        let (vars_p, params_p, out_p) = (p[0], p[1], p[2]);
-        let mem = MemFlagsData::trusted();
-        let slot = (slot_len > 0).then(|| {
-            b.create_sized_stack_slot(StackSlotData::new(
-                StackSlotKind::ExplicitSlot,
-                8 * slot_len,
-                3,
-            ))
-        });
-        // Imported lazily: the batch function, or libm's sin and cos for the cold path.
-        let mut batch_fn: Option<FuncRef> = None;
-        let mut libm_fns: Option<(FuncRef, FuncRef)> = None;
-        let mut src: Vec<Source> = vec![Source::None; nodes.len()];
-        // Inline sin/cos by argument node.
-        let mut sincos_done: FxHashMap<NodeId, (Value, Value)> = FxHashMap::default();
-        // Emission order: node order (children first), so the forward pass precedes the
-        // arithmetic of the gradients (a depth-first schedule that emits each node just
-        // before its first use compiled 2× slower on design models). With batches: by
-        // depth, each depth's plain nodes, then its batch.
-        let order: Vec<Vec<usize>> = if mode == Math::Batch {
-            // A plain node is at most one deeper than the deepest batch.
-            let mut by_depth = vec![Vec::new(); batches.len() + 1];
-            for (i, n) in nodes.iter().enumerate() {
-                if mark[i] && !is_trig(n) && !matches!(n, Node::Const(_)) {
-                    by_depth[depth[i] as usize].push(i);
+    let mut seen: FxHashMap<(u32, NodeId), ()> = FxHashMap::default();
+    for (i, n) in nodes.iter().enumerate() {
+        if !mark[i] || !is_trig(n) {
+            continue;
+        }
+        let d = depth[i] as usize;
+        if batches.len() <= d {
+            batches.resize_with(d + 1, Batch::default);
+        }
+        match *n {
+            Node::Sin(a) | Node::Cos(a) => {
+                if seen.insert((d as u32, a), ()).is_none() {
+                    batches[d].sc.push(a);
                 }
             }
-            by_depth
-        } else {
-            vec![
-                (0..nodes.len())
-                    .filter(|&i| mark[i] && !matches!(nodes[i], Node::Const(_)))
-                    .collect(),
-            ]
-        };
-        // Values used far from where they are computed (the forward values the gradients
-        // re-read) are stored once in a spill slot, and uses beyond `SPILL_WINDOW`
-        // positions reload them: their SSA values stay short-lived, so the register
-        // allocator has no long live ranges to split (the arm's models compile in 40 %
-        // less time, and run as fast). Stores and loads move the bits unchanged.
-        // Positions in the emission order: each emitted node, then each depth's batch.
+            Node::Atan2(..) => batches[d].at.push(i),
+            _ => batches[d].ac.push(i),
+        }
+    }
+    let mut base = 0u32;
+    for bt in &mut batches {
+        bt.base = base;
+        base += bt.len() as u32;
+    }
+    (depth, batches)
+}
+
+/// The emission order: node order (children first), so the forward pass precedes the
+/// arithmetic of the gradients (a depth-first schedule that emits each node just before
+/// its first use compiled 2× slower on design models). With batches (`n_batches` groups
+/// by `depth`): by depth, each depth's plain nodes, then its batch.
+fn emission_order(
+    nodes: &[Node],
+    mark: &[bool],
+    mode: Math,
+    depth: &[u32],
+    n_batches: usize,
+) -> Vec<Vec<usize>> {
+    if mode == Math::Batch {
+        // A plain node is at most one deeper than the deepest batch.
+        let mut by_depth = vec![Vec::new(); n_batches + 1];
+        for (i, n) in nodes.iter().enumerate() {
+            if mark[i] && !is_trig(n) && !matches!(n, Node::Const(_)) {
+                by_depth[depth[i] as usize].push(i);
+            }
+        }
+        by_depth
+    } else {
+        vec![
+            (0..nodes.len())
+                .filter(|&i| mark[i] && !matches!(nodes[i], Node::Const(_)))
+                .collect(),
+        ]
+    }
+}
+
+/// Positions in the emission order (each emitted node, then each depth's batch) and the
+/// spill slot's layout.
+///
+/// Values used far from where they are computed (the forward values the gradients
+/// re-read) are stored once in a spill slot, and uses beyond [`SPILL_WINDOW`] positions
+/// reload them: their SSA values stay short-lived, so the register allocator has no long
+/// live ranges to split (the arm's models compile in 40 % less time, and run as fast).
+/// Stores and loads move the bits unchanged.
+struct Schedule {
+    /// Each emitted node's position (`usize::MAX`: not emitted on its own).
+    pos: Vec<usize>,
+    /// Each depth's batch position.
+    batch_pos: Vec<usize>,
+    /// The number of positions (the outputs are read after all of them).
+    n_pos: usize,
+    /// Each spilled node's f64 offset in the spill slot (`u32::MAX`: not spilled).
+    spill_off: Vec<u32>,
+    /// The spill slot's length in f64s.
+    spill_len: u32,
+}
+
+impl Schedule {
+    fn new(
+        nodes: &[Node],
+        order: &[Vec<usize>],
+        fused: &[bool],
+        batches: &[Batch],
+        outputs: &[NodeId],
+    ) -> Schedule {
         let mut pos = vec![usize::MAX; nodes.len()];
         let mut batch_pos = vec![usize::MAX; order.len()];
         let mut last_use = vec![0usize; nodes.len()];
@@ -445,201 +435,360 @@ pub(crate) fn define_eval<M: Module>(
                 spill_len += 1;
             }
         }
-        n_spilled = spill_len as usize;
-        let spill = (spill_len > 0).then(|| {
-            b.create_sized_stack_slot(StackSlotData::new(
-                StackSlotKind::ExplicitSlot,
-                8 * spill_len,
-                3,
-            ))
-        });
-
-        // Operand values. Constants are materialized at each use rather than once: a
-        // constant shared by thousands of nodes would otherwise be one value live across
-        // the whole function (and across every call); batch results likewise are reloaded
-        // from their slot.
-        let operand = |b: &mut FunctionBuilder, src: &[Source], id: NodeId, at: usize| -> Value {
-            match (*graph.node(id), src[id.index()]) {
-                (Node::Const(c), _) => b.ins().f64const(c),
-                (_, Source::Value(v)) => v,
-                (_, Source::Spilled(v, def, _)) if at - def <= SPILL_WINDOW => v,
-                (_, Source::Spilled(_, _, off)) => b.ins().stack_load(
-                    ptr,
-                    types::F64,
-                    spill.expect("a spill slot exists"),
-                    8 * off as i32,
-                ),
-                (_, Source::Slot(off)) => b.ins().stack_load(
-                    ptr,
-                    types::F64,
-                    slot.expect("a slot exists"),
-                    8 * off as i32,
-                ),
-                (_, Source::None) => unreachable!("children are emitted first"),
-            }
-        };
-
-        for (d, phase) in order.iter().enumerate() {
-            for &i in phase {
-                if fused[i] {
-                    // Emitted inside its one user's fma.
-                    continue;
-                }
-                let node = nodes[i];
-                let at_pos = pos[i];
-                let mut o = [None; 3];
-                // (operand position, factors) of a product fused into this sum.
-                let mut fma: Option<(usize, Value, Value)> = None;
-                for (k, c) in node.children().into_iter().enumerate() {
-                    // Inline sin/cos whose argument was already done needs no operand.
-                    if matches!(node, Node::Sin(_) | Node::Cos(_)) && sincos_done.contains_key(&c) {
-                        continue;
-                    }
-                    if fused[c.index()]
-                        && let Node::Mul(p, q) = nodes[c.index()]
-                    {
-                        let (p, q) = (
-                            operand(&mut b, &src, p, at_pos),
-                            operand(&mut b, &src, q, at_pos),
-                        );
-                        fma = Some((k, p, q));
-                        continue;
-                    }
-                    o[k] = Some(operand(&mut b, &src, c, at_pos));
-                }
-                let v = |k: usize| o[k].expect("operand emitted");
-                let x = match (node, fma) {
-                    // a·b + c, c + a·b
-                    (Node::Add(..), Some((k, p, q))) => b.ins().fma(p, q, v(1 - k)),
-                    // a·b − c
-                    (Node::Sub(..), Some((0, p, q))) => {
-                        let c = b.ins().fneg(v(1));
-                        b.ins().fma(p, q, c)
-                    }
-                    // c − a·b
-                    (Node::Sub(..), Some((_, p, q))) => {
-                        let p = b.ins().fneg(p);
-                        b.ins().fma(p, q, v(0))
-                    }
-                    (_, Some(_)) => unreachable!("only sums and differences fuse"),
-                    (node, None) => match node {
-                        Node::Const(_) => unreachable!("constants are emitted at their uses"),
-                        Node::Var(k) => b.ins().load(types::F64, mem, vars_p, 8 * k as i32),
-                        Node::Param(k) => b.ins().load(types::F64, mem, params_p, 8 * k as i32),
-                        Node::Add(..) => b.ins().fadd(v(0), v(1)),
-                        Node::Sub(..) => b.ins().fsub(v(0), v(1)),
-                        Node::Mul(..) => b.ins().fmul(v(0), v(1)),
-                        Node::Div(..) => b.ins().fdiv(v(0), v(1)),
-                        Node::Neg(_) => b.ins().fneg(v(0)),
-                        Node::Sqrt(_) => b.ins().sqrt(v(0)),
-                        Node::Sin(a) | Node::Cos(a) => {
-                            let (sv, cv) = match sincos_done.get(&a) {
-                                Some(&r) => r,
-                                None => {
-                                    let fns = *libm_fns.get_or_insert_with(|| {
-                                        let [s, c] = import_libm(module, b.func);
-                                        (s, c)
-                                    });
-                                    let r = inline_sin_cos(&mut b, v(0), fns);
-                                    n_calls += 2;
-                                    sincos_done.insert(a, r);
-                                    r
-                                }
-                            };
-                            if matches!(node, Node::Sin(_)) { sv } else { cv }
-                        }
-                        Node::Acos(_) => trig::emit_acos(&mut Ir { b: &mut b }, v(0)),
-                        Node::Atan2(..) => trig::emit_atan2(&mut Ir { b: &mut b }, v(0), v(1)),
-                        Node::Sgn(_) => {
-                            let a = v(0);
-                            let zero = b.ins().f64const(0.0);
-                            let one = b.ins().f64const(1.0);
-                            let mone = b.ins().f64const(-1.0);
-                            let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
-                            let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
-                            let neg_or_zero = b.ins().select(lt, mone, zero);
-                            b.ins().select(gt, one, neg_or_zero)
-                        }
-                        Node::Clamp(_) => clamp_unit(&mut b, v(0)),
-                        Node::Select(..) => {
-                            let zero = b.ins().f64const(0.0);
-                            let gt = b.ins().fcmp(FloatCC::GreaterThan, v(0), zero);
-                            b.ins().select(gt, v(1), v(2))
-                        }
-                    },
-                };
-                n_inst += 1;
-                src[i] = if spill_off[i] == u32::MAX {
-                    Source::Value(x)
-                } else {
-                    let slot = spill.expect("a spill slot exists");
-                    b.ins().stack_store(ptr, x, slot, 8 * spill_off[i] as i32);
-                    Source::Spilled(x, at_pos, spill_off[i])
-                };
-            }
-            let Some(bt) = batches.get(d) else { continue };
-            if bt.len() == 0 {
-                continue;
-            }
-            let at_pos = batch_pos[d];
-            // The batch: store the arguments, one call, results stay in the slot.
-            let slot = slot.expect("a slot exists");
-            let (nsc, nat, nac) = (bt.sc.len(), bt.at.len(), bt.ac.len());
-            let at = |k: usize| 8 * (bt.base as usize + k) as i32;
-            let mut stores: Vec<(NodeId, usize)> = Vec::new();
-            for (k, &a) in bt.sc.iter().enumerate() {
-                stores.push((a, k));
-            }
-            for (k, &i) in bt.at.iter().enumerate() {
-                let [y, x] = [0, 1].map(|j| nodes[i].children().as_slice()[j]);
-                stores.push((y, nsc + k));
-                stores.push((x, nsc + nat + k));
-            }
-            for (k, &i) in bt.ac.iter().enumerate() {
-                stores.push((nodes[i].children().as_slice()[0], nsc + 2 * nat + k));
-            }
-            for (id, k) in stores {
-                let x = operand(&mut b, &src, id, at_pos);
-                b.ins().stack_store(ptr, x, slot, at(k));
-            }
-            let f = *batch_fn.get_or_insert_with(|| import_batch(module, b.func, ptr));
-            let addr = b.ins().stack_addr(ptr, slot, at(0));
-            let n = [nsc, nat, nac].map(|n| b.ins().iconst(ptr, n as i64));
-            b.ins().call(f, &[addr, n[0], n[1], n[2]]);
-            n_calls += 1;
-            n_inst += 1;
-            let out0 = bt.base + (nsc + 2 * nat + nac) as u32;
-            let by_arg: FxHashMap<NodeId, usize> =
-                bt.sc.iter().enumerate().map(|(k, &a)| (a, k)).collect();
-            for (i, n) in nodes.iter().enumerate() {
-                if !mark[i] || !is_trig(n) || depth[i] as usize != d {
-                    continue;
-                }
-                let k = match *n {
-                    Node::Sin(a) => by_arg[&a],
-                    Node::Cos(a) => nsc + by_arg[&a],
-                    Node::Atan2(..) => 2 * nsc + bt.at.iter().position(|&j| j == i).unwrap_or(0),
-                    _ => 2 * nsc + nat + bt.ac.iter().position(|&j| j == i).unwrap_or(0),
-                };
-                src[i] = Source::Slot(out0 + k as u32);
-            }
+        Schedule {
+            pos,
+            batch_pos,
+            n_pos,
+            spill_off,
+            spill_len,
         }
-        for (k, o) in outputs.iter().enumerate() {
-            let x = operand(&mut b, &src, *o, n_pos);
-            b.ins().store(mem, x, out_p, 8 * k as i32);
-        }
-        b.ins().return_(&[]);
-        b.seal_all_blocks();
-        b.finalize(target);
     }
+}
+
+/// An explicit stack slot of `len` f64s (none when empty).
+fn f64_slot(b: &mut FunctionBuilder, len: u32) -> Option<StackSlot> {
+    (len > 0).then(|| {
+        b.create_sized_stack_slot(StackSlotData::new(StackSlotKind::ExplicitSlot, 8 * len, 3))
+    })
+}
+
+/// Define `name` in `module`: the function computing `outputs` of `graph` (`mark`: the
+/// nodes they reach, from [`crate::expr::check_indices`]) with transcendentals by `mode`.
+///
+/// Where the ISA has fused multiply-add, a sum or difference at node index `fuse_from` or
+/// above whose operand is a product used nowhere else becomes one `fma` (one rounding
+/// instead of two, and one instruction: the gradients [`super::compile`] appends are
+/// mostly sums of products). Nodes below `fuse_from` round as the interpreter does, bit
+/// for bit; `usize::MAX` fuses nothing.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn define_eval<M: Module>(
+    module: &mut M,
+    name: &str,
+    linkage: Linkage,
+    graph: &ExprGraph,
+    outputs: &[NodeId],
+    mark: &[bool],
+    mode: Math,
+    fuse_from: usize,
+) -> Result<Built, CompileError> {
+    let ptr = module.target_config().pointer_type();
+    let mut sig = module.make_signature();
+    for _ in 0..3 {
+        sig.params.push(AbiParam::new(ptr));
+    }
+    let func_id = module.declare_function(name, linkage, &sig).map_err(cg)?;
+    let nodes = graph.nodes();
+    let (depth, batches) = if mode == Math::Batch {
+        group_by_depth(nodes, mark)
+    } else {
+        (vec![0u32; nodes.len()], Vec::new())
+    };
+    let slot_len: u32 = batches.iter().map(|b| b.len() as u32).sum();
+    let fused = fusable_products(
+        graph,
+        outputs,
+        mark,
+        fuse_from,
+        module.isa().has_native_fma(),
+    );
+    let order = emission_order(nodes, mark, mode, &depth, batches.len());
+    let plan = Schedule::new(nodes, &order, &fused, &batches, outputs);
+
+    let mut ctx: Context = module.make_context();
+    ctx.func.signature = sig;
+    ctx.func.name = UserFuncName::user(0, func_id.as_u32());
+    let mut fctx = FunctionBuilderContext::new();
+    let target = module.target_config();
+    let mut b = FunctionBuilder::new(&mut ctx.func, &mut fctx);
+    let block = b.create_block();
+    b.append_block_params_for_function_params(block);
+    b.switch_to_block(block);
+    let p = b.block_params(block).to_vec();
+    let slot = f64_slot(&mut b, slot_len);
+    let spill = f64_slot(&mut b, plan.spill_len);
+    let mut e = Emitter {
+        module: &mut *module,
+        b,
+        graph,
+        fused: &fused,
+        spill_off: &plan.spill_off,
+        ptr,
+        mem: MemFlagsData::trusted(),
+        args: [p[0], p[1], p[2]],
+        slot,
+        spill,
+        src: vec![Source::None; nodes.len()],
+        sincos_done: FxHashMap::default(),
+        batch_fn: None,
+        libm_fns: None,
+        n_inst: 0,
+        n_calls: 0,
+    };
+    for (d, phase) in order.iter().enumerate() {
+        for &i in phase {
+            // A fused product is emitted inside its one user's fma.
+            if !fused[i] {
+                e.node(i, plan.pos[i]);
+            }
+        }
+        if let Some(bt) = batches.get(d)
+            && bt.len() > 0
+        {
+            e.batch(bt, d, plan.batch_pos[d], &depth, mark);
+        }
+    }
+    let (n_inst, n_calls) = e.finish(outputs, plan.n_pos, target);
     module.define_function(func_id, &mut ctx).map_err(cg)?;
     module.clear_context(&mut ctx);
     Ok(Built {
         id: func_id,
         n_instructions: n_inst,
         n_calls,
-        n_spilled,
+        n_spilled: plan.spill_len as usize,
     })
+}
+
+/// The function under construction: the builder, where each node's value is, and the
+/// callees imported so far.
+struct Emitter<'a, 'f, M: Module> {
+    module: &'a mut M,
+    b: FunctionBuilder<'f>,
+    graph: &'a ExprGraph,
+    /// Products emitted inside their user's `fma` (from [`fusable_products`]).
+    fused: &'a [bool],
+    /// [`Schedule::spill_off`].
+    spill_off: &'a [u32],
+    ptr: types::Type,
+    mem: MemFlagsData,
+    /// The function's parameters: `vars`, `params`, `out`.
+    args: [Value; 3],
+    /// The batch slot and the spill slot, where needed.
+    slot: Option<StackSlot>,
+    spill: Option<StackSlot>,
+    src: Vec<Source>,
+    /// Inline sin/cos by argument node.
+    sincos_done: FxHashMap<NodeId, (Value, Value)>,
+    /// Imported lazily: the batch function, or libm's sin and cos for the cold path.
+    batch_fn: Option<FuncRef>,
+    libm_fns: Option<(FuncRef, FuncRef)>,
+    n_inst: usize,
+    n_calls: usize,
+}
+
+/// A node's operands as [`Emitter::operands`] emits them: the children's values by
+/// position, and a product fused into this node as `(position, factor, factor)`.
+type Operands = ([Option<Value>; 3], Option<(usize, Value, Value)>);
+
+impl<M: Module> Emitter<'_, '_, M> {
+    /// The value of node `id` for a use at position `at` of the emission order.
+    /// Constants are materialized at each use rather than once: a constant shared by
+    /// thousands of nodes would otherwise be one value live across the whole function (and
+    /// across every call); batch results likewise are reloaded from their slot.
+    fn operand(&mut self, id: NodeId, at: usize) -> Value {
+        match (*self.graph.node(id), self.src[id.index()]) {
+            (Node::Const(c), _) => self.b.ins().f64const(c),
+            (_, Source::Value(v)) => v,
+            (_, Source::Spilled(v, def, _)) if at - def <= SPILL_WINDOW => v,
+            (_, Source::Spilled(_, _, off)) => self.b.ins().stack_load(
+                self.ptr,
+                types::F64,
+                self.spill.expect("a spill slot exists"),
+                8 * off as i32,
+            ),
+            (_, Source::Slot(off)) => self.b.ins().stack_load(
+                self.ptr,
+                types::F64,
+                self.slot.expect("a slot exists"),
+                8 * off as i32,
+            ),
+            (_, Source::None) => unreachable!("children are emitted first"),
+        }
+    }
+
+    /// Emit node `i` at position `at` of the emission order (stored to the spill slot too
+    /// if it is used far away).
+    fn node(&mut self, i: usize, at: usize) {
+        let node = self.graph.nodes()[i];
+        let (o, fma) = self.operands(node, at);
+        let x = match fma {
+            Some((k, p, q)) => self.fused_sum(node, k, p, q, &o),
+            None => self.op(node, &o),
+        };
+        self.n_inst += 1;
+        self.src[i] = if self.spill_off[i] == u32::MAX {
+            Source::Value(x)
+        } else {
+            let slot = self.spill.expect("a spill slot exists");
+            self.b
+                .ins()
+                .stack_store(self.ptr, x, slot, 8 * self.spill_off[i] as i32);
+            Source::Spilled(x, at, self.spill_off[i])
+        };
+    }
+
+    /// The operands of `node` for a use at `at`, in child order.
+    fn operands(&mut self, node: Node, at: usize) -> Operands {
+        let mut o = [None; 3];
+        let mut fma: Option<(usize, Value, Value)> = None;
+        for (k, c) in node.children().into_iter().enumerate() {
+            // Inline sin/cos whose argument was already done needs no operand.
+            if matches!(node, Node::Sin(_) | Node::Cos(_)) && self.sincos_done.contains_key(&c) {
+                continue;
+            }
+            if self.fused[c.index()]
+                && let Node::Mul(p, q) = self.graph.nodes()[c.index()]
+            {
+                let (p, q) = (self.operand(p, at), self.operand(q, at));
+                fma = Some((k, p, q));
+                continue;
+            }
+            o[k] = Some(self.operand(c, at));
+        }
+        (o, fma)
+    }
+
+    /// The sum or difference `node` whose operand `k` is the fused product `p·q`: one
+    /// `fma`.
+    fn fused_sum(
+        &mut self,
+        node: Node,
+        k: usize,
+        p: Value,
+        q: Value,
+        o: &[Option<Value>; 3],
+    ) -> Value {
+        let v = |k: usize| o[k].expect("operand emitted");
+        match (node, k) {
+            // a·b + c, c + a·b
+            (Node::Add(..), k) => self.b.ins().fma(p, q, v(1 - k)),
+            // a·b − c
+            (Node::Sub(..), 0) => {
+                let c = self.b.ins().fneg(v(1));
+                self.b.ins().fma(p, q, c)
+            }
+            // c − a·b
+            (Node::Sub(..), _) => {
+                let p = self.b.ins().fneg(p);
+                self.b.ins().fma(p, q, v(0))
+            }
+            _ => unreachable!("only sums and differences fuse"),
+        }
+    }
+
+    /// `node` of operands `o`, unfused.
+    fn op(&mut self, node: Node, o: &[Option<Value>; 3]) -> Value {
+        let v = |k: usize| o[k].expect("operand emitted");
+        let [vars_p, params_p, _] = self.args;
+        let b = &mut self.b;
+        match node {
+            Node::Const(_) => unreachable!("constants are emitted at their uses"),
+            Node::Var(k) => b.ins().load(types::F64, self.mem, vars_p, 8 * k as i32),
+            Node::Param(k) => b.ins().load(types::F64, self.mem, params_p, 8 * k as i32),
+            Node::Add(..) => b.ins().fadd(v(0), v(1)),
+            Node::Sub(..) => b.ins().fsub(v(0), v(1)),
+            Node::Mul(..) => b.ins().fmul(v(0), v(1)),
+            Node::Div(..) => b.ins().fdiv(v(0), v(1)),
+            Node::Neg(_) => b.ins().fneg(v(0)),
+            Node::Sqrt(_) => b.ins().sqrt(v(0)),
+            Node::Sin(a) | Node::Cos(a) => {
+                let (sv, cv) = self.sin_cos(a, o[0]);
+                if matches!(node, Node::Sin(_)) { sv } else { cv }
+            }
+            Node::Acos(_) => trig::emit_acos(&mut Ir { b }, v(0)),
+            Node::Atan2(..) => trig::emit_atan2(&mut Ir { b }, v(0), v(1)),
+            Node::Sgn(_) => sgn(b, v(0)),
+            Node::Clamp(_) => clamp_unit(b, v(0)),
+            Node::Select(..) => select_positive(b, v(0), v(1), v(2)),
+        }
+    }
+
+    /// `(sin x, cos x)` inline for argument node `a` (value `x`, absent when done), once
+    /// per argument.
+    fn sin_cos(&mut self, a: NodeId, x: Option<Value>) -> (Value, Value) {
+        if let Some(&r) = self.sincos_done.get(&a) {
+            return r;
+        }
+        let fns = *self.libm_fns.get_or_insert_with(|| {
+            let [s, c] = import_libm(self.module, self.b.func);
+            (s, c)
+        });
+        let r = inline_sin_cos(&mut self.b, x.expect("operand emitted"), fns);
+        self.n_calls += 2;
+        self.sincos_done.insert(a, r);
+        r
+    }
+
+    /// The batch `bt` of depth `d` at position `at`: store the arguments, one call; the
+    /// results stay in the slot, where the group's nodes read them.
+    fn batch(&mut self, bt: &Batch, d: usize, at: usize, depth: &[u32], mark: &[bool]) {
+        let slot = self.slot.expect("a slot exists");
+        let nodes = self.graph.nodes();
+        let (nsc, nat, nac) = (bt.sc.len(), bt.at.len(), bt.ac.len());
+        let off = |k: usize| 8 * (bt.base as usize + k) as i32;
+        for (id, k) in bt.stores(nodes) {
+            let x = self.operand(id, at);
+            self.b.ins().stack_store(self.ptr, x, slot, off(k));
+        }
+        let f = *self
+            .batch_fn
+            .get_or_insert_with(|| import_batch(self.module, self.b.func, self.ptr));
+        let addr = self.b.ins().stack_addr(self.ptr, slot, off(0));
+        let n = [nsc, nat, nac].map(|n| self.b.ins().iconst(self.ptr, n as i64));
+        self.b.ins().call(f, &[addr, n[0], n[1], n[2]]);
+        self.n_calls += 1;
+        self.n_inst += 1;
+        let out0 = bt.base + (nsc + 2 * nat + nac) as u32;
+        let by_arg: FxHashMap<NodeId, usize> =
+            bt.sc.iter().enumerate().map(|(k, &a)| (a, k)).collect();
+        for (i, n) in nodes.iter().enumerate() {
+            if !mark[i] || !is_trig(n) || depth[i] as usize != d {
+                continue;
+            }
+            let k = match *n {
+                Node::Sin(a) => by_arg[&a],
+                Node::Cos(a) => nsc + by_arg[&a],
+                Node::Atan2(..) => 2 * nsc + bt.at.iter().position(|&j| j == i).unwrap_or(0),
+                _ => 2 * nsc + nat + bt.ac.iter().position(|&j| j == i).unwrap_or(0),
+            };
+            self.src[i] = Source::Slot(out0 + k as u32);
+        }
+    }
+
+    /// Store the outputs (read at position `at`, after every other) and close the
+    /// function. Returns the instructions and calls emitted.
+    fn finish(
+        mut self,
+        outputs: &[NodeId],
+        at: usize,
+        target: TargetFrontendConfig,
+    ) -> (usize, usize) {
+        for (k, o) in outputs.iter().enumerate() {
+            let x = self.operand(*o, at);
+            self.b.ins().store(self.mem, x, self.args[2], 8 * k as i32);
+        }
+        self.b.ins().return_(&[]);
+        self.b.seal_all_blocks();
+        self.b.finalize(target);
+        (self.n_inst, self.n_calls)
+    }
+}
+
+/// `sgn(a)`: 1, −1 or 0 (NaN gives 0, as [`Node::eval_with`]).
+fn sgn(b: &mut FunctionBuilder, a: Value) -> Value {
+    let zero = b.ins().f64const(0.0);
+    let one = b.ins().f64const(1.0);
+    let mone = b.ins().f64const(-1.0);
+    let gt = b.ins().fcmp(FloatCC::GreaterThan, a, zero);
+    let lt = b.ins().fcmp(FloatCC::LessThan, a, zero);
+    let neg_or_zero = b.ins().select(lt, mone, zero);
+    b.ins().select(gt, one, neg_or_zero)
+}
+
+/// `select(c, u, v)`: `u` where `c > 0`, else `v` (NaN selects `v`).
+fn select_positive(b: &mut FunctionBuilder, c: Value, u: Value, v: Value) -> Value {
+    let zero = b.ins().f64const(0.0);
+    let gt = b.ins().fcmp(FloatCC::GreaterThan, c, zero);
+    b.ins().select(gt, u, v)
 }
 
 /// Which products [`define_eval`] fuses into their user (`fma` on): a `Mul` used exactly

@@ -3,9 +3,9 @@
 //! The adjoint of every node is accumulated in reverse topological order (decreasing node
 //! id) as new nodes of the same graph, so the gradient shares every forward node (the
 //! value+gradient cost is a small multiple of the value's). Only nodes that depend on a
-//! variable get adjoints. The local partials are [`mod@super::jacobian`]'s (independent of
-//! the adjoint, so the sweep and the vertex elimination share them, and every quotient by
-//! `y` in them is a product with the one reciprocal `1/y`).
+//! variable get adjoints. The local partials are those of the vertex elimination
+//! ([`mod@super::jacobian`]) too, from one shared file (independent of the adjoint, and
+//! every quotient by `y` in them is a product with the one reciprocal `1/y`).
 //!
 //! Derivatives never produce NaN or infinities where the function is finite:
 //! - `sgn`: 0;
@@ -25,7 +25,7 @@
 //! NaN although the value is finite (forward mode would not). The kinematics never
 //! discards a non-finite branch (its only forward selects are `max(0, x)`).
 
-use super::jacobian::{atan2_weight, partials, recip, scale};
+use super::partials::{atan2_weight, partials, recip, scale};
 use crate::expr::{ExprGraph, Node, NodeId, ShapeError, check_indices};
 
 /// The gradient of `output` with respect to variables `0..n_vars`, as nodes of `graph`.
@@ -146,16 +146,6 @@ fn sweep(g: &mut ExprGraph, output: NodeId, n_vars: usize) -> Vec<NodeId> {
     }
     let zero = g.constant(0.0);
     grad.into_iter().map(|d| d.unwrap_or(zero)).collect()
-}
-
-/// `(1 - c)(1 + c)` with `c = clamp(x)`: `1 - x²` computed without cancellation, and
-/// never negative. The simplifier builds `sin(acos x)` as the square root of this very node.
-pub(crate) fn one_minus_sq_node(g: &mut ExprGraph, x: NodeId) -> NodeId {
-    let c = g.add(Node::Clamp(x));
-    let one = g.constant(1.0);
-    let a = g.add(Node::Sub(one, c));
-    let b = g.add(Node::Add(one, c));
-    g.add(Node::Mul(a, b))
 }
 
 #[cfg(test)]

@@ -22,11 +22,12 @@
 //! assert!((buf[c.layout.gradient(0).start] - d).abs() < 1e-15);
 //! ```
 //!
-//! Stages: [`simplify`] (egg), [`diff`] (reverse mode) and [`mod@jacobian`] (reverse sweeps or
-//! vertex elimination), [`codegen`] (the Cranelift function
-//! builder) behind [`jit`] (in process) and [`aot`] (object, shared library, C header); [`dual`] is
-//! the forward-mode oracle the tests hold the differentiator to; [`vertex`] builds the
-//! symbolic PTU of one vertex (for `foldsynth formulas` and `foldsynth bench vertex`).
+//! Stages: [`simplify`] (egg), [`diff`] (reverse mode) and [`mod@jacobian`] (reverse sweeps
+//! or vertex elimination; both take their local partials from `partials`), [`codegen`] (the
+//! Cranelift function builder) behind [`jit`] (in process) and [`aot`] (object, shared
+//! library, C header); [`dual`] is the forward-mode oracle the tests hold the differentiator
+//! to; [`vertex`] builds the symbolic PTU of one vertex (for `foldsynth formulas` and
+//! `foldsynth bench vertex`).
 //! With the cargo feature `symbolica`, `symbolica` is the second pipeline and printer
 //! built on Symbolica (on its own thread).
 
@@ -36,6 +37,7 @@ pub mod diff;
 pub mod dual;
 pub mod jacobian;
 pub mod jit;
+mod partials;
 pub mod simplify;
 #[cfg(feature = "symbolica")]
 pub mod symbolica;

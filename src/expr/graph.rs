@@ -193,142 +193,10 @@ impl ExprGraph {
             }
         }
         match node {
-            Add(a, b) => {
-                if self.is_const(b, 0.0) {
-                    return a;
-                }
-                if self.is_const(a, 0.0) {
-                    return b;
-                }
-                if let Some(nb) = self.neg_of(b) {
-                    return self.add(Sub(a, nb));
-                }
-                if let Some(na) = self.neg_of(a) {
-                    return self.add(Sub(b, na));
-                }
-                if a == b {
-                    // x + x = 2x exactly.
-                    let two = self.constant(2.0);
-                    return self.add(Mul(two, a));
-                }
-                // Commutative: canonical operand order, so a+b and b+a are one node.
-                let (a, b) = if a <= b { (a, b) } else { (b, a) };
-                self.intern(Add(a, b))
-            }
-            Sub(a, b) => {
-                if self.is_const(b, 0.0) {
-                    return a;
-                }
-                if self.is_const(a, 0.0) {
-                    return self.add(Neg(b));
-                }
-                if a == b && self.finite(a) {
-                    return self.constant(0.0);
-                }
-                if let Some(nb) = self.neg_of(b) {
-                    return self.add(Add(a, nb));
-                }
-                if let Some(na) = self.neg_of(a) {
-                    // (-x) - b = -(x + b) exactly (rounding is symmetric), so that
-                    // -(-x - b) becomes x + b.
-                    let s = self.add(Add(na, b));
-                    return self.add(Neg(s));
-                }
-                self.intern(Sub(a, b))
-            }
-            Mul(a, b) => {
-                if self.is_const(a, 1.0) {
-                    return b;
-                }
-                if self.is_const(b, 1.0) {
-                    return a;
-                }
-                if self.is_const(a, -1.0) {
-                    return self.add(Neg(b));
-                }
-                if self.is_const(b, -1.0) {
-                    return self.add(Neg(a));
-                }
-                if (self.is_const(a, 0.0) && self.finite(b))
-                    || (self.is_const(b, 0.0) && self.finite(a))
-                {
-                    return self.constant(0.0);
-                }
-                // Negations move outward (exact), so they cancel and share.
-                match (self.neg_of(a), self.neg_of(b)) {
-                    (Some(x), Some(y)) => return self.add(Mul(x, y)),
-                    (Some(x), None) => {
-                        let m = self.add(Mul(x, b));
-                        return self.add(Neg(m));
-                    }
-                    (None, Some(y)) => {
-                        let m = self.add(Mul(a, y));
-                        return self.add(Neg(m));
-                    }
-                    (None, None) => {}
-                }
-                // A negative constant factor becomes a negation outside (exact): `-2·x`
-                // and `2·x` share, and `y + (-2)·x` becomes `y - 2·x`.
-                for (k, x) in [(a, b), (b, a)] {
-                    if let Some(c) = self.const_value(k)
-                        && c < 0.0
-                    {
-                        let pos = self.constant(-c);
-                        let m = self.add(Mul(pos, x));
-                        return self.add(Neg(m));
-                    }
-                }
-                // Constants first, then by id.
-                let (a, b) = match (self.const_value(a), self.const_value(b)) {
-                    (None, Some(_)) => (b, a),
-                    (Some(_), None) => (a, b),
-                    _ if a <= b => (a, b),
-                    _ => (b, a),
-                };
-                self.intern(Mul(a, b))
-            }
-            Div(a, b) => {
-                if self.is_const(b, 1.0) {
-                    return a;
-                }
-                if self.is_const(b, -1.0) {
-                    return self.add(Neg(a));
-                }
-                if let Some(c) = self.const_value(b) {
-                    // Division by a power of two is multiplication by its exact inverse.
-                    let inv = 1.0 / c;
-                    if c.is_finite() && c != 0.0 && is_power_of_two(c.abs()) && inv.is_finite() {
-                        let k = self.constant(inv);
-                        return self.add(Mul(k, a));
-                    }
-                }
-                for (k, first) in [(a, true), (b, false)] {
-                    if let Some(c) = self.const_value(k)
-                        && c < 0.0
-                    {
-                        let pos = self.constant(-c);
-                        let d = if first {
-                            self.add(Div(pos, b))
-                        } else {
-                            self.add(Div(a, pos))
-                        };
-                        return self.add(Neg(d));
-                    }
-                }
-                match (self.neg_of(a), self.neg_of(b)) {
-                    (Some(x), Some(y)) => return self.add(Div(x, y)),
-                    (Some(x), None) => {
-                        let d = self.add(Div(x, b));
-                        return self.add(Neg(d));
-                    }
-                    (None, Some(y)) => {
-                        let d = self.add(Div(a, y));
-                        return self.add(Neg(d));
-                    }
-                    (None, None) => {}
-                }
-                self.intern(Div(a, b))
-            }
+            Add(a, b) => self.fold_add(a, b),
+            Sub(a, b) => self.fold_sub(a, b),
+            Mul(a, b) => self.fold_mul(a, b),
+            Div(a, b) => self.fold_div(a, b),
             Neg(a) => {
                 if let Some(x) = self.neg_of(a) {
                     return x;
@@ -362,38 +230,196 @@ impl ExprGraph {
                 }
                 self.intern(Clamp(a))
             }
-            Sgn(a) => {
-                let r = self.ranges[a.index()];
-                if r.finite && r.lo > 0.0 {
-                    return self.constant(1.0);
-                }
-                if r.finite && r.hi < 0.0 {
-                    return self.constant(-1.0);
-                }
-                match self.nodes[a.index()] {
-                    Sgn(_) => a,
-                    Neg(x) => {
-                        let s = self.add(Sgn(x));
-                        self.add(Neg(s))
-                    }
-                    _ => self.intern(Sgn(a)),
-                }
-            }
-            Select(c, a, b) => {
-                if a == b {
-                    return a;
-                }
-                let r = self.ranges[c.index()];
-                if r.finite && r.lo > 0.0 {
-                    return a;
-                }
-                if r.finite && r.hi <= 0.0 {
-                    return b;
-                }
-                self.intern(Select(c, a, b))
-            }
+            Sgn(a) => self.fold_sgn(a),
+            Select(c, a, b) => self.fold_select(c, a, b),
             Sqrt(_) | Atan2(..) | Const(_) | Var(_) | Param(_) => self.intern(node),
         }
+    }
+
+    /// `a + b`: zeros dropped, negations turned into differences, `x + x = 2x`, operands in
+    /// canonical order.
+    fn fold_add(&mut self, a: NodeId, b: NodeId) -> NodeId {
+        use Node::*;
+        if self.is_const(b, 0.0) {
+            return a;
+        }
+        if self.is_const(a, 0.0) {
+            return b;
+        }
+        if let Some(nb) = self.neg_of(b) {
+            return self.add(Sub(a, nb));
+        }
+        if let Some(na) = self.neg_of(a) {
+            return self.add(Sub(b, na));
+        }
+        if a == b {
+            // x + x = 2x exactly.
+            let two = self.constant(2.0);
+            return self.add(Mul(two, a));
+        }
+        // Commutative: canonical operand order, so a+b and b+a are one node.
+        let (a, b) = if a <= b { (a, b) } else { (b, a) };
+        self.intern(Add(a, b))
+    }
+
+    /// `a - b`: zeros dropped, `x - x = 0` for finite `x`, negations moved out.
+    fn fold_sub(&mut self, a: NodeId, b: NodeId) -> NodeId {
+        use Node::*;
+        if self.is_const(b, 0.0) {
+            return a;
+        }
+        if self.is_const(a, 0.0) {
+            return self.add(Neg(b));
+        }
+        if a == b && self.finite(a) {
+            return self.constant(0.0);
+        }
+        if let Some(nb) = self.neg_of(b) {
+            return self.add(Add(a, nb));
+        }
+        if let Some(na) = self.neg_of(a) {
+            // (-x) - b = -(x + b) exactly (rounding is symmetric), so that
+            // -(-x - b) becomes x + b.
+            let s = self.add(Add(na, b));
+            return self.add(Neg(s));
+        }
+        self.intern(Sub(a, b))
+    }
+
+    /// `a · b`: ±1 and finite·0 folded, negations and negative constant factors moved
+    /// outward, constants first.
+    fn fold_mul(&mut self, a: NodeId, b: NodeId) -> NodeId {
+        use Node::*;
+        if self.is_const(a, 1.0) {
+            return b;
+        }
+        if self.is_const(b, 1.0) {
+            return a;
+        }
+        if self.is_const(a, -1.0) {
+            return self.add(Neg(b));
+        }
+        if self.is_const(b, -1.0) {
+            return self.add(Neg(a));
+        }
+        if (self.is_const(a, 0.0) && self.finite(b)) || (self.is_const(b, 0.0) && self.finite(a)) {
+            return self.constant(0.0);
+        }
+        // Negations move outward (exact), so they cancel and share.
+        match (self.neg_of(a), self.neg_of(b)) {
+            (Some(x), Some(y)) => return self.add(Mul(x, y)),
+            (Some(x), None) => {
+                let m = self.add(Mul(x, b));
+                return self.add(Neg(m));
+            }
+            (None, Some(y)) => {
+                let m = self.add(Mul(a, y));
+                return self.add(Neg(m));
+            }
+            (None, None) => {}
+        }
+        // A negative constant factor becomes a negation outside (exact): `-2·x`
+        // and `2·x` share, and `y + (-2)·x` becomes `y - 2·x`.
+        for (k, x) in [(a, b), (b, a)] {
+            if let Some(c) = self.const_value(k)
+                && c < 0.0
+            {
+                let pos = self.constant(-c);
+                let m = self.add(Mul(pos, x));
+                return self.add(Neg(m));
+            }
+        }
+        // Constants first, then by id.
+        let (a, b) = match (self.const_value(a), self.const_value(b)) {
+            (None, Some(_)) => (b, a),
+            (Some(_), None) => (a, b),
+            _ if a <= b => (a, b),
+            _ => (b, a),
+        };
+        self.intern(Mul(a, b))
+    }
+
+    /// `a / b`: ±1 folded, a power of two as a product, negations and negative constants
+    /// moved outward.
+    fn fold_div(&mut self, a: NodeId, b: NodeId) -> NodeId {
+        use Node::*;
+        if self.is_const(b, 1.0) {
+            return a;
+        }
+        if self.is_const(b, -1.0) {
+            return self.add(Neg(a));
+        }
+        if let Some(c) = self.const_value(b) {
+            // Division by a power of two is multiplication by its exact inverse.
+            let inv = 1.0 / c;
+            if c.is_finite() && c != 0.0 && is_power_of_two(c.abs()) && inv.is_finite() {
+                let k = self.constant(inv);
+                return self.add(Mul(k, a));
+            }
+        }
+        for (k, first) in [(a, true), (b, false)] {
+            if let Some(c) = self.const_value(k)
+                && c < 0.0
+            {
+                let pos = self.constant(-c);
+                let d = if first {
+                    self.add(Div(pos, b))
+                } else {
+                    self.add(Div(a, pos))
+                };
+                return self.add(Neg(d));
+            }
+        }
+        match (self.neg_of(a), self.neg_of(b)) {
+            (Some(x), Some(y)) => return self.add(Div(x, y)),
+            (Some(x), None) => {
+                let d = self.add(Div(x, b));
+                return self.add(Neg(d));
+            }
+            (None, Some(y)) => {
+                let d = self.add(Div(a, y));
+                return self.add(Neg(d));
+            }
+            (None, None) => {}
+        }
+        self.intern(Div(a, b))
+    }
+
+    /// `sgn(a)`: constant where the range of `a` decides it; `sgn(sgn x) = sgn x`,
+    /// `sgn(-x) = -sgn x`.
+    fn fold_sgn(&mut self, a: NodeId) -> NodeId {
+        use Node::*;
+        let r = self.ranges[a.index()];
+        if r.finite && r.lo > 0.0 {
+            return self.constant(1.0);
+        }
+        if r.finite && r.hi < 0.0 {
+            return self.constant(-1.0);
+        }
+        match self.nodes[a.index()] {
+            Sgn(_) => a,
+            Neg(x) => {
+                let s = self.add(Sgn(x));
+                self.add(Neg(s))
+            }
+            _ => self.intern(Sgn(a)),
+        }
+    }
+
+    /// `select(c, a, b)`: one branch where the range of `c` decides it or both are equal.
+    fn fold_select(&mut self, c: NodeId, a: NodeId, b: NodeId) -> NodeId {
+        use Node::*;
+        if a == b {
+            return a;
+        }
+        let r = self.ranges[c.index()];
+        if r.finite && r.lo > 0.0 {
+            return a;
+        }
+        if r.finite && r.hi <= 0.0 {
+            return b;
+        }
+        self.intern(Select(c, a, b))
     }
 
     /// The range of `node` (whose children are in this graph) given ranges of its children

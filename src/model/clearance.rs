@@ -213,65 +213,75 @@ fn merges(p: [f64; 2], q: [f64; 2]) -> bool {
     (-p[0] - q[0]).hypot(-p[1] - q[1]) <= 1e-9
 }
 
-impl Pairs {
-    /// The pairs of `plan`: arm facets among themselves, with the rotated copy when
-    /// `second_arm` (whose tips meet when `tip`, the gripping vertex, is given), and with
-    /// every cylinder.
-    pub fn new(plan: &Plan, second_arm: bool, tip: Option<usize>, cylinders: &[Cylinder]) -> Pairs {
-        let facets: Vec<(usize, Vec<usize>)> = plan
-            .polygons
-            .iter()
-            .enumerate()
-            .filter(|(_, (p, _))| p.len() >= 3)
-            .map(|(f, (p, _))| (f, p.clone()))
-            .collect();
-        // The copy of vertex j coincides with arm vertex i when both are fixed and the
-        // rotation maps one onto the other (v1 at the origin for the gripper): the two arms
-        // share it, as in `check::two_armed`.
-        let fixed = |v: usize| match plan.vertices[v].position {
-            Position::Fixed(p) => Some(p),
-            Position::Placed { .. } | Position::Between { .. } => None,
+/// An arm vertex.
+fn arm(v: usize) -> VRef {
+    VRef {
+        vertex: v,
+        copy: false,
+    }
+}
+
+/// A vertex of the rotated copy.
+fn cpy(v: usize) -> VRef {
+    VRef {
+        vertex: v,
+        copy: true,
+    }
+}
+
+/// The vertices `vs` but `skip`, as references by `r`.
+fn without(vs: &[usize], skip: usize, r: fn(usize) -> VRef) -> Vec<VRef> {
+    vs.iter().copied().filter(|u| *u != skip).map(r).collect()
+}
+
+/// The arm vertex that the copy of vertex `j` coincides with, if any: both are fixed and
+/// the rotation maps one onto the other (v1 at the origin for the gripper), so the two
+/// arms share it, as in `check::two_armed`.
+fn copy_is(plan: &Plan, j: usize) -> Option<usize> {
+    let fixed = |v: usize| match plan.vertices[v].position {
+        Position::Fixed(p) => Some(p),
+        Position::Placed { .. } | Position::Between { .. } => None,
+    };
+    let q = fixed(j)?;
+    (0..plan.vertices.len()).find(|&i| fixed(i).is_some_and(|p| merges(q, p)))
+}
+
+/// The pairs built so far and the next free slot.
+struct PairList {
+    pairs: Vec<Pair>,
+    slot: usize,
+}
+
+impl PairList {
+    fn push(
+        &mut self,
+        a: (usize, bool),
+        b: Option<(usize, bool)>,
+        kind: PairKind,
+        group: Group,
+        a_verts: Vec<VRef>,
+        b_verts: Vec<VRef>,
+    ) {
+        let p = Pair {
+            a,
+            b,
+            kind,
+            group,
+            a_verts,
+            b_verts,
+            slot: self.slot,
         };
-        let copy_is = |j: usize| -> Option<usize> {
-            let q = fixed(j)?;
-            (0..plan.vertices.len()).find(|&i| fixed(i).is_some_and(|p| merges(q, p)))
-        };
-        let arm = |v: usize| VRef {
-            vertex: v,
-            copy: false,
-        };
-        let cpy = |v: usize| VRef {
-            vertex: v,
-            copy: true,
-        };
-        let mut pairs = Vec::new();
-        let mut slot = 0;
-        let mut push = |a: (usize, bool),
-                        b: Option<(usize, bool)>,
-                        kind: PairKind,
-                        group: Group,
-                        a_verts: Vec<VRef>,
-                        b_verts: Vec<VRef>| {
-            let p = Pair {
-                a,
-                b,
-                kind,
-                group,
-                a_verts,
-                b_verts,
-                slot,
-            };
-            slot += p.slots();
-            pairs.push(p);
-        };
-        let without = |vs: &[usize], skip: usize, r: &dyn Fn(usize) -> VRef| -> Vec<VRef> {
-            vs.iter().copied().filter(|u| *u != skip).map(r).collect()
-        };
+        self.slot += p.slots();
+        self.pairs.push(p);
+    }
+
+    /// The arm's facet pairs: apart, or meeting at a vertex.
+    fn self_pairs(&mut self, facets: &[(usize, Vec<usize>)]) {
         for (i, (_, va)) in facets.iter().enumerate() {
             for (j, (_, vb)) in facets.iter().enumerate().skip(i + 1) {
                 let shared: Vec<usize> = va.iter().copied().filter(|v| vb.contains(v)).collect();
                 match shared.as_slice() {
-                    [] => push(
+                    [] => self.push(
                         (i, false),
                         Some((j, false)),
                         PairKind::Apart,
@@ -279,7 +289,7 @@ impl Pairs {
                         va.iter().map(|v| arm(*v)).collect(),
                         vb.iter().map(|v| arm(*v)).collect(),
                     ),
-                    [v] => push(
+                    [v] => self.push(
                         (i, false),
                         Some((j, false)),
                         PairKind::Cone {
@@ -287,8 +297,8 @@ impl Pairs {
                             b: arm(*v),
                         },
                         Group::SelfPair,
-                        without(va, *v, &arm),
-                        without(vb, *v, &arm),
+                        without(va, *v, arm),
+                        without(vb, *v, arm),
                     ),
                     // Facets sharing a crease: their fold angle (the model's crease
                     // constraints). Two shared vertices without a crease do not occur in
@@ -297,55 +307,67 @@ impl Pairs {
                 }
             }
         }
-        if second_arm {
-            // (f, copy g) and (g, copy f) are the same pair turned by 180°: keep f ≤ g.
-            for (i, (_, va)) in facets.iter().enumerate() {
-                for (j, (_, vb)) in facets.iter().enumerate().skip(i) {
-                    let shared: Vec<(usize, usize)> = vb
-                        .iter()
-                        .filter_map(|&q| copy_is(q).filter(|a| va.contains(a)).map(|a| (a, q)))
-                        .collect();
-                    let tips = tip.filter(|g| va.contains(g) && vb.contains(g));
-                    match (shared.as_slice(), tips) {
-                        ([], None) => push(
-                            (i, false),
-                            Some((j, true)),
-                            PairKind::Apart,
-                            Group::Arm,
-                            va.iter().map(|v| arm(*v)).collect(),
-                            vb.iter().map(|v| cpy(*v)).collect(),
-                        ),
-                        // The tips stay in the lists: each keeps to its side of the plane
-                        // (see `constraints`), or the facets cross within the tips' offset.
-                        ([], Some(g)) => push(
-                            (i, false),
-                            Some((j, true)),
-                            PairKind::Cone {
-                                a: arm(g),
-                                b: cpy(g),
-                            },
-                            Group::Arm,
-                            va.iter().map(|v| arm(*v)).collect(),
-                            vb.iter().map(|v| cpy(*v)).collect(),
-                        ),
-                        ([(a, q)], None) => push(
-                            (i, false),
-                            Some((j, true)),
-                            PairKind::Cone {
-                                a: arm(*a),
-                                b: arm(*a),
-                            },
-                            Group::Arm,
-                            without(va, *a, &arm),
-                            without(vb, *q, &cpy),
-                        ),
-                        // Touching at two points (a shared vertex and the tips): left to
-                        // the intersection check.
-                        _ => {}
-                    }
+    }
+
+    /// The pairs of an arm facet and a facet of the rotated copy (whose tips meet when
+    /// `tip`, the gripping vertex, is given).
+    fn arm_pairs(&mut self, plan: &Plan, facets: &[(usize, Vec<usize>)], tip: Option<usize>) {
+        // (f, copy g) and (g, copy f) are the same pair turned by 180°: keep f ≤ g.
+        for (i, (_, va)) in facets.iter().enumerate() {
+            for (j, (_, vb)) in facets.iter().enumerate().skip(i) {
+                let shared: Vec<(usize, usize)> = vb
+                    .iter()
+                    .filter_map(|&q| copy_is(plan, q).filter(|a| va.contains(a)).map(|a| (a, q)))
+                    .collect();
+                let tips = tip.filter(|g| va.contains(g) && vb.contains(g));
+                match (shared.as_slice(), tips) {
+                    ([], None) => self.push(
+                        (i, false),
+                        Some((j, true)),
+                        PairKind::Apart,
+                        Group::Arm,
+                        va.iter().map(|v| arm(*v)).collect(),
+                        vb.iter().map(|v| cpy(*v)).collect(),
+                    ),
+                    // The tips stay in the lists: each keeps to its side of the plane
+                    // (see `constraints`), or the facets cross within the tips' offset.
+                    ([], Some(g)) => self.push(
+                        (i, false),
+                        Some((j, true)),
+                        PairKind::Cone {
+                            a: arm(g),
+                            b: cpy(g),
+                        },
+                        Group::Arm,
+                        va.iter().map(|v| arm(*v)).collect(),
+                        vb.iter().map(|v| cpy(*v)).collect(),
+                    ),
+                    ([(a, q)], None) => self.push(
+                        (i, false),
+                        Some((j, true)),
+                        PairKind::Cone {
+                            a: arm(*a),
+                            b: arm(*a),
+                        },
+                        Group::Arm,
+                        without(va, *a, arm),
+                        without(vb, *q, cpy),
+                    ),
+                    // Touching at two points (a shared vertex and the tips): left to
+                    // the intersection check.
+                    _ => {}
                 }
             }
         }
+    }
+
+    /// The pairs of a facet and a cylinder.
+    fn obstacle_pairs(
+        &mut self,
+        facets: &[(usize, Vec<usize>)],
+        cylinders: &[Cylinder],
+        second_arm: bool,
+    ) {
         for (k, cyl) in cylinders.iter().enumerate() {
             // The copy's facets only need their own pairs when the cylinder is not mapped
             // onto itself by the rotation.
@@ -358,7 +380,7 @@ impl Pairs {
                     continue;
                 }
                 for (i, (_, vs)) in facets.iter().enumerate() {
-                    push(
+                    self.push(
                         (i, copy),
                         None,
                         PairKind::Obstacle { k },
@@ -369,10 +391,34 @@ impl Pairs {
                 }
             }
         }
+    }
+}
+
+impl Pairs {
+    /// The pairs of `plan`: arm facets among themselves, with the rotated copy when
+    /// `second_arm` (whose tips meet when `tip`, the gripping vertex, is given), and with
+    /// every cylinder.
+    pub fn new(plan: &Plan, second_arm: bool, tip: Option<usize>, cylinders: &[Cylinder]) -> Pairs {
+        let facets: Vec<(usize, Vec<usize>)> = plan
+            .polygons
+            .iter()
+            .enumerate()
+            .filter(|(_, (p, _))| p.len() >= 3)
+            .map(|(f, (p, _))| (f, p.clone()))
+            .collect();
+        let mut list = PairList {
+            pairs: Vec::new(),
+            slot: 0,
+        };
+        list.self_pairs(&facets);
+        if second_arm {
+            list.arm_pairs(plan, &facets, tip);
+        }
+        list.obstacle_pairs(&facets, cylinders, second_arm);
         Pairs {
             facets,
-            pairs,
-            slots: slot,
+            pairs: list.pairs,
+            slots: list.slot,
             cylinders: cylinders.to_vec(),
         }
     }

@@ -279,7 +279,82 @@ impl Builder {
     }
 
     fn build(&self, graph: &CreaseGraph) -> Result<Plan, PlanError> {
-        // Creases.
+        let (creases, actuation) = self.creases(graph)?;
+        let mut vertices = Vec::new();
+        for v in graph.vertices() {
+            let position = self.position(graph, v)?;
+            self.v(v.vid)?;
+            let rays = self.rays(v, &creases)?;
+            vertices.push(Vertex {
+                name: vertices.len() + 1,
+                position,
+                preds: v.preds.len(),
+                internal: v.extended,
+                rays,
+                sectors: Vec::new(),
+            });
+        }
+        for i in 0..vertices.len() {
+            let sectors = sector_rules(&vertices, &creases, i)?;
+            vertices[i].sectors = sectors;
+        }
+        let facets = graph.facet_count();
+        let polygons = facet_polygons(&creases, facets)?;
+        let internal: Vec<usize> = graph
+            .extension_order()
+            .iter()
+            .map(|v| self.v(*v))
+            .collect::<Result<_, _>>()?;
+        let (walk, known) = facet_walk(&vertices, &creases, &internal, &actuation, facets)?;
+        if let Some(f) = known.iter().position(|k| !k)
+            && polygons[f].0.len() >= 2
+        {
+            return Err(PlanError(format!(
+                "facet {} cannot be placed: none of its creases has a known dihedral angle",
+                graph.facet_name(crate::grammar::FacetId(f as u32))
+            )));
+        }
+        let home_facet = home_facets(&polygons, &known, vertices.len())?;
+        let variables = graph
+            .variables()
+            .iter()
+            .map(|v| Variable {
+                kind: v.kind,
+                name: v.name.clone(),
+            })
+            .collect();
+        let constraints = self.constraints(graph, &vertices, &creases)?;
+        let sinks = sinks(&vertices, &creases)?;
+        let candidates = match graph.gripping_candidates() {
+            Some(c) => Some([self.v(c[0])?, self.v(c[1])?, self.v(c[2])?]),
+            None => None,
+        };
+        Ok(Plan {
+            sequence: graph.sequence(),
+            vertices,
+            creases,
+            facets,
+            facet_names: (0..facets)
+                .map(|f| {
+                    graph
+                        .facet_name(crate::grammar::FacetId(f as u32))
+                        .to_string()
+                })
+                .collect(),
+            polygons,
+            internal,
+            actuation,
+            walk,
+            home_facet,
+            variables,
+            constraints,
+            candidates,
+            sinks,
+        })
+    }
+
+    /// The creases with dense indices, and the one driven crease.
+    fn creases(&self, graph: &CreaseGraph) -> Result<(Vec<Crease>, Actuation), PlanError> {
         let mut creases = Vec::new();
         let mut driven = Vec::new();
         for (i, c) in graph.creases().enumerate() {
@@ -316,188 +391,98 @@ impl Builder {
                 ));
             }
         };
+        Ok((creases, actuation))
+    }
 
-        // Vertices: positions and rays.
-        let mut vertices = Vec::new();
-        for v in graph.vertices() {
-            let position = match (&v.placement, v.g0_coords) {
-                (Some(p), _) => {
-                    let crease = graph
-                        .creases()
-                        .position(|c| matches!(c.origin, CreaseOrigin::Extension { created, .. } if created == v.vid))
-                        .ok_or_else(|| PlanError(format!("no crease placed vertex {:?}", v.vid)))?;
-                    Position::Placed {
-                        parent: self.v(p.parent)?,
-                        reference: self.v(p.reference)?,
-                        sign: p.sign,
-                        sectors: p.sectors.iter().map(|s| s.0 as usize).collect(),
-                        length: p.length.0 as usize,
-                        crease,
-                    }
-                }
-                (None, Some(xy)) => Position::Fixed(xy),
-                (None, None) if v.sink_between.is_some() => {
-                    let [a, b] = v.sink_between.expect("checked");
-                    Position::Between {
-                        a: self.v(a)?,
-                        b: self.v(b)?,
-                    }
-                }
-                (None, None) => {
-                    return Err(PlanError(format!("vertex {:?} has no position", v.vid)));
-                }
-            };
-            let me = self.v(v.vid)?;
-            let mut rays = Vec::new();
-            for &c in &v.preds {
-                let k = self.c(c)?;
-                rays.push(Ray {
-                    crease: k,
-                    other: creases[k].tail,
-                    outgoing: false,
-                });
-            }
-            if v.extended || v.ty == VertexType::Terminal {
-                for c in v.slots.iter().flatten() {
-                    let k = self.c(*c)?;
-                    rays.push(Ray {
-                        crease: k,
-                        other: creases[k].head,
-                        outgoing: true,
-                    });
+    /// How vertex `v` of `graph` is positioned in the plane.
+    fn position(
+        &self,
+        graph: &CreaseGraph,
+        v: &crate::grammar::Vertex,
+    ) -> Result<Position, PlanError> {
+        Ok(match (&v.placement, v.g0_coords) {
+            (Some(p), _) => {
+                let crease = graph
+                    .creases()
+                    .position(|c| matches!(c.origin, CreaseOrigin::Extension { created, .. } if created == v.vid))
+                    .ok_or_else(|| PlanError(format!("no crease placed vertex {:?}", v.vid)))?;
+                Position::Placed {
+                    parent: self.v(p.parent)?,
+                    reference: self.v(p.reference)?,
+                    sign: p.sign,
+                    sectors: p.sectors.iter().map(|s| s.0 as usize).collect(),
+                    length: p.length.0 as usize,
+                    crease,
                 }
             }
-            let _ = me;
-            vertices.push(Vertex {
-                name: vertices.len() + 1,
-                position,
-                preds: v.preds.len(),
-                internal: v.extended,
-                rays,
-                sectors: Vec::new(),
+            (None, Some(xy)) => Position::Fixed(xy),
+            (None, None) if v.sink_between.is_some() => {
+                let [a, b] = v.sink_between.expect("checked");
+                Position::Between {
+                    a: self.v(a)?,
+                    b: self.v(b)?,
+                }
+            }
+            (None, None) => {
+                return Err(PlanError(format!("vertex {:?} has no position", v.vid)));
+            }
+        })
+    }
+
+    /// The rays of vertex `v`: its incoming creases, then (once extended, or for a
+    /// terminal vertex) its slots.
+    fn rays(&self, v: &crate::grammar::Vertex, creases: &[Crease]) -> Result<Vec<Ray>, PlanError> {
+        let mut rays = Vec::new();
+        for &c in &v.preds {
+            let k = self.c(c)?;
+            rays.push(Ray {
+                crease: k,
+                other: creases[k].tail,
+                outgoing: false,
             });
         }
-
-        // Sectors.
-        for i in 0..vertices.len() {
-            let sectors = sector_rules(&vertices, &creases, i)?;
-            vertices[i].sectors = sectors;
-        }
-
-        // Facet polygons from the crease labels.
-        let facets = graph.facet_count();
-        let polygons = facet_polygons(&creases, facets)?;
-
-        // The facet walk.
-        let internal: Vec<usize> = graph
-            .extension_order()
-            .iter()
-            .map(|v| self.v(*v))
-            .collect::<Result<_, _>>()?;
-        let mut known = vec![false; facets];
-        let act = &creases[actuation.crease];
-        known[act.left] = true;
-        known[act.right] = true;
-        let mut walk = Vec::new();
-        for &a in &internal {
-            let v = &vertices[a];
-            let n = v.rays.len();
-            let ccw_facet = |k: usize| {
-                let r = &v.rays[k];
-                let c = &creases[r.crease];
-                if r.outgoing { c.left } else { c.right }
-            };
-            let start = (0..n).find(|&k| known[ccw_facet(k)]).ok_or_else(|| {
-                PlanError(format!("no facet around v{} has a known placement", v.name))
-            })?;
-            for j in 1..n {
-                let k = (start + j) % n;
-                let f = ccw_facet(k);
-                if !known[f] {
-                    walk.push(WalkStep {
-                        facet: f,
-                        from: ccw_facet((k + n - 1) % n),
-                        vertex: a,
-                        ray: k,
-                    });
-                    known[f] = true;
-                }
+        if v.extended || v.ty == VertexType::Terminal {
+            for c in v.slots.iter().flatten() {
+                let k = self.c(*c)?;
+                rays.push(Ray {
+                    crease: k,
+                    other: creases[k].head,
+                    outgoing: true,
+                });
             }
         }
-        if let Some(f) = known.iter().position(|k| !k)
-            && polygons[f].0.len() >= 2
-        {
-            return Err(PlanError(format!(
-                "facet {} cannot be placed: none of its creases has a known dihedral angle",
-                graph.facet_name(crate::grammar::FacetId(f as u32))
-            )));
-        }
-        let mut home_facet = vec![usize::MAX; vertices.len()];
-        for (f, (poly, _)) in polygons.iter().enumerate() {
-            for &v in poly {
-                if home_facet[v] == usize::MAX && known[f] {
-                    home_facet[v] = f;
-                }
-            }
-        }
-        if let Some(v) = home_facet.iter().position(|f| *f == usize::MAX) {
-            return Err(PlanError(format!(
-                "vertex v{} lies on no placed facet",
-                v + 1
-            )));
-        }
+        Ok(rays)
+    }
 
-        // Variables and constraints.
-        let variables = graph
-            .variables()
-            .iter()
-            .map(|v| Variable {
-                kind: v.kind,
-                name: v.name.clone(),
-            })
-            .collect();
+    /// The constraints the graph states, in the plan's terms (box bounds of plain
+    /// variables left out, duplicates in a row merged).
+    fn constraints(
+        &self,
+        graph: &CreaseGraph,
+        vertices: &[Vertex],
+        creases: &[Crease],
+    ) -> Result<Vec<Constraint>, PlanError> {
         let mut constraints = Vec::new();
         for spec in graph.constraints() {
             match spec {
                 ConstraintSpec::Sector {
                     vertex, from, to, ..
                 } => {
-                    let (v, k) = self.sector_index(&vertices, vertex, from, to)?;
+                    let (v, k) = self.sector_index(vertices, vertex, from, to)?;
                     if !is_plain_variable(&vertices[v].sectors[k]) {
-                        for lower in [true, false] {
-                            constraints.push(Constraint::Sector {
-                                vertex: v,
-                                k,
-                                lower,
-                                source: "Eq. 31",
-                            });
-                        }
+                        sector_bounds(&mut constraints, v, k, "Eq. 31");
                     }
                 }
                 ConstraintSpec::Remainder { vertex, from, to } => {
-                    let (v, k) = self.sector_index(&vertices, vertex, from, to)?;
+                    let (v, k) = self.sector_index(vertices, vertex, from, to)?;
                     // Eq. 31 bounds the closing sector from below only; we bound it from
                     // above too: a sector beyond π makes a unit angle > π, outside the
                     // Euler triangles the PTU's triangle inequality is valid for (Sec. 4.4).
-                    for lower in [true, false] {
-                        constraints.push(Constraint::Sector {
-                            vertex: v,
-                            k,
-                            lower,
-                            source: "Eq. 31",
-                        });
-                    }
+                    sector_bounds(&mut constraints, v, k, "Eq. 31");
                 }
                 ConstraintSpec::MergedSector { vertex, from, to } => {
-                    let (v, k) = self.sector_index(&vertices, vertex, from, to)?;
-                    for lower in [true, false] {
-                        constraints.push(Constraint::Sector {
-                            vertex: v,
-                            k,
-                            lower,
-                            source: "Eq. 34",
-                        });
-                    }
+                    let (v, k) = self.sector_index(vertices, vertex, from, to)?;
+                    sector_bounds(&mut constraints, v, k, "Eq. 34");
                 }
                 ConstraintSpec::Length { crease, .. } => {
                     let c = self.c(crease)?;
@@ -516,51 +501,7 @@ impl Builder {
             }
         }
         constraints.dedup();
-        let mut sinks = Vec::new();
-        for (i, v) in vertices.iter().enumerate() {
-            if let Position::Between { a, b } = v.position {
-                let (c1, c2) = (v.rays[0].crease, v.rays[1].crease);
-                if creases[c1].tail != a || creases[c2].tail != b {
-                    return Err(PlanError(format!(
-                        "the sink v{} is not fed by its two ends",
-                        v.name
-                    )));
-                }
-                sinks.push(Sink {
-                    vertex: i,
-                    ends: [a, b],
-                    creases: [c1, c2],
-                    inner: creases[c1].right,
-                    outer: creases[c1].left,
-                });
-            }
-        }
-        let candidates = match graph.gripping_candidates() {
-            Some(c) => Some([self.v(c[0])?, self.v(c[1])?, self.v(c[2])?]),
-            None => None,
-        };
-        Ok(Plan {
-            sequence: graph.sequence(),
-            vertices,
-            creases,
-            facets,
-            facet_names: (0..facets)
-                .map(|f| {
-                    graph
-                        .facet_name(crate::grammar::FacetId(f as u32))
-                        .to_string()
-                })
-                .collect(),
-            polygons,
-            internal,
-            actuation,
-            walk,
-            home_facet,
-            variables,
-            constraints,
-            candidates,
-            sinks,
-        })
+        Ok(constraints)
     }
 
     /// The sector at `vertex` from crease `from` to crease `to` (counter-clockwise).
@@ -580,6 +521,109 @@ impl Builder {
             .map(|k| (v, k))
             .ok_or_else(|| PlanError(format!("v{} has no sector between those creases", v + 1)))
     }
+}
+
+/// Both bounds of sector `k` at `vertex`.
+fn sector_bounds(out: &mut Vec<Constraint>, vertex: usize, k: usize, source: &'static str) {
+    for lower in [true, false] {
+        out.push(Constraint::Sector {
+            vertex,
+            k,
+            lower,
+            source,
+        });
+    }
+}
+
+/// The facet walk: around each internal vertex in extension order, from a facet with a
+/// known placement counter-clockwise, each facet not yet placed gets its map. Returns the
+/// walk and which facets it placed (the actuated crease's two facets to begin with).
+fn facet_walk(
+    vertices: &[Vertex],
+    creases: &[Crease],
+    internal: &[usize],
+    actuation: &Actuation,
+    facets: usize,
+) -> Result<(Vec<WalkStep>, Vec<bool>), PlanError> {
+    let mut known = vec![false; facets];
+    let act = &creases[actuation.crease];
+    known[act.left] = true;
+    known[act.right] = true;
+    let mut walk = Vec::new();
+    for &a in internal {
+        let v = &vertices[a];
+        let n = v.rays.len();
+        let ccw_facet = |k: usize| {
+            let r = &v.rays[k];
+            let c = &creases[r.crease];
+            if r.outgoing { c.left } else { c.right }
+        };
+        let start = (0..n).find(|&k| known[ccw_facet(k)]).ok_or_else(|| {
+            PlanError(format!("no facet around v{} has a known placement", v.name))
+        })?;
+        for j in 1..n {
+            let k = (start + j) % n;
+            let f = ccw_facet(k);
+            if !known[f] {
+                walk.push(WalkStep {
+                    facet: f,
+                    from: ccw_facet((k + n - 1) % n),
+                    vertex: a,
+                    ray: k,
+                });
+                known[f] = true;
+            }
+        }
+    }
+    Ok((walk, known))
+}
+
+/// For every vertex, the first placed facet (by index) whose polygon contains it.
+fn home_facets(
+    polygons: &[(Vec<usize>, bool)],
+    known: &[bool],
+    n_vertices: usize,
+) -> Result<Vec<usize>, PlanError> {
+    let mut home_facet = vec![usize::MAX; n_vertices];
+    for (f, (poly, _)) in polygons.iter().enumerate() {
+        for &v in poly {
+            if home_facet[v] == usize::MAX && known[f] {
+                home_facet[v] = f;
+            }
+        }
+    }
+    if let Some(v) = home_facet.iter().position(|f| *f == usize::MAX) {
+        return Err(PlanError(format!(
+            "vertex v{} lies on no placed facet",
+            v + 1
+        )));
+    }
+    Ok(home_facet)
+}
+
+/// The cycles r2′ closed: every vertex placed between two others, with the creases from
+/// its two ends.
+fn sinks(vertices: &[Vertex], creases: &[Crease]) -> Result<Vec<Sink>, PlanError> {
+    let mut sinks = Vec::new();
+    for (i, v) in vertices.iter().enumerate() {
+        if let Position::Between { a, b } = v.position {
+            let (c1, c2) = (v.rays[0].crease, v.rays[1].crease);
+            if creases[c1].tail != a || creases[c2].tail != b {
+                return Err(PlanError(format!(
+                    "the sink v{} is not fed by its two ends",
+                    v.name
+                )));
+            }
+            sinks.push(Sink {
+                vertex: i,
+                ends: [a, b],
+                creases: [c1, c2],
+                inner: creases[c1].right,
+                outer: creases[c1].left,
+            });
+        }
+    }
+    Ok(sinks)
 }
 
 /// A sector that is exactly one variable (its bounds are the variable's box).
