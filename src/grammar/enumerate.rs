@@ -21,7 +21,8 @@ use serde::Serialize;
 
 use super::canon::Code;
 use super::graph::CreaseGraph;
-use super::notation::{Step, parse_sequence};
+use super::notation::parse_sequence;
+use super::step::Step;
 use crate::task::Task;
 
 /// Which filters run. Each can be switched off.

@@ -84,6 +84,7 @@ mod enumerate;
 mod graph;
 mod notation;
 mod rules;
+mod step;
 mod straight;
 
 pub use canon::Code;
@@ -92,8 +93,9 @@ pub use enumerate::{
     TooLarge, dot_header, dot_node,
 };
 pub use graph::{CreaseGraph, FacetBoundary, FacetError};
-pub use notation::{NotationError, Step, format_sequence, parse_sequence};
+pub use notation::{NotationError, format_sequence, parse_sequence};
 pub use rules::{R2Match, RuleError};
+pub use step::Step;
 pub use straight::StraightSink;
 
 use serde::{Deserialize, Serialize};

@@ -4,7 +4,7 @@
 use petgraph::algo::has_path_connecting;
 
 use super::graph::CreaseGraph;
-use super::notation::Step;
+use super::step::Step;
 use super::{
     Cid, ConstraintSpec, Crease, CreaseOrigin, Created, FacetId, Placement, R1Record, R2Record,
     StepRecord, Substitution, VarId, VarKind, Variable, VertexType, Vid,

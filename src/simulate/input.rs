@@ -118,6 +118,15 @@ impl Drive {
     }
 }
 
+/// Most solver iterations one reported step may spend on refinement, by default
+/// ([`SolverSettings::refine_budget`]). A step that follows
+/// a branch refines along one path; near a flat or singular state that can take a few
+/// hundred thousand (352,111 for the last step of the gripper's g06-c2-uu at N_max = 2,
+/// seed 1), so the budget is several times that. A motion that no step size can follow
+/// would otherwise refine every half down to `max_refine`, 2^18 substeps: hours, found
+/// by fuzzing.
+pub const REFINE_ITERATION_BUDGET: usize = 2_000_000;
+
 /// Stopping rules of the per-step least-squares solve, and the step control.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverSettings {
@@ -142,7 +151,7 @@ pub struct SolverSettings {
     /// its branch; the cross-validation allows 18.
     pub max_refine: usize,
     /// Most solver iterations one reported step may spend on refinement (default
-    /// [`super::run::REFINE_ITERATION_BUDGET`]); where it stops, the step is taken as it
+    /// [`REFINE_ITERATION_BUDGET`]); where it stops, the step is taken as it
     /// stands and reported as capped.
     pub refine_budget: usize,
 }
@@ -156,7 +165,7 @@ impl Default for SolverSettings {
             residual_tolerance: 1e-15,
             max_correction: f64::INFINITY,
             max_refine: 6,
-            refine_budget: super::run::REFINE_ITERATION_BUDGET,
+            refine_budget: REFINE_ITERATION_BUDGET,
         }
     }
 }
