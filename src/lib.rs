@@ -26,5 +26,6 @@ pub mod pattern;
 pub mod search;
 pub mod simulate;
 pub mod task;
+mod task_load;
 pub mod text;
 pub mod trig;

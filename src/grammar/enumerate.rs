@@ -21,7 +21,8 @@ use serde::Serialize;
 
 use super::canon::Code;
 use super::graph::CreaseGraph;
-use super::notation::{Step, parse_sequence};
+use super::notation::parse_sequence;
+use super::step::Step;
 use crate::task::Task;
 
 /// Which filters run. Each can be switched off.
@@ -317,6 +318,50 @@ struct Open {
     steps: Vec<Step>,
 }
 
+/// The parent rebuilt from its sequence: the same rule applications that made it, so the
+/// same graph (`None`: G0).
+fn rebuilt(root: &CreaseGraph, parent: Option<&Open>) -> CreaseGraph {
+    match parent {
+        None => root.clone(),
+        Some(open) => {
+            let mut g = root.clone();
+            for &step in &open.steps {
+                g.apply_step(step)
+                    .expect("a generated graph's own sequence applies");
+            }
+            g
+        }
+    }
+}
+
+/// Every child of `g` under `rules`: r1's matches, then r2's, then r2′'s.
+fn children(g: &CreaseGraph, rules: Rules, n_max: usize) -> Vec<CreaseGraph> {
+    let mut children = Vec::new();
+    if rules.r1 {
+        for v in g.r1_matches(n_max) {
+            let mut c = g.clone();
+            c.extend(v).expect("r1 matches what r1_matches found");
+            children.push(c);
+        }
+    }
+    if rules.r2 {
+        for (_, m) in g.r2_matches() {
+            let mut c = g.clone();
+            c.combine(m).expect("r2 matches what r2_matches found");
+            children.push(c);
+        }
+    }
+    if rules.r2p {
+        for (_, m) in g.r2p_matches() {
+            let mut c = g.clone();
+            c.combine_straight(m)
+                .expect("r2′ matches what r2p_matches found");
+            children.push(c);
+        }
+    }
+    children
+}
+
 /// 128 bits of a canonical code: the filters compare codes of every graph seen so far,
 /// and a digest keeps that set small (two SipHash-1-3 of the code under different
 /// prefixes; a collision among 10^7 graphs has probability about 10^-25).
@@ -435,43 +480,9 @@ impl Enumeration {
             level += 1;
             let mut next = Vec::new();
             for parent in frontier {
-                // The parent rebuilt from its sequence: the same rule applications that
-                // made it, so the same graph.
-                let g = match &parent {
-                    None => root.clone(),
-                    Some(open) => {
-                        let mut g = root.clone();
-                        for &step in &open.steps {
-                            g.apply_step(step)
-                                .expect("a generated graph's own sequence applies");
-                        }
-                        g
-                    }
-                };
+                let g = rebuilt(&root, parent.as_ref());
                 let parent_index = parent.as_ref().map(|o| o.index);
-                let mut children = Vec::new();
-                if rules.r1 {
-                    for v in g.r1_matches(n_max) {
-                        let mut c = g.clone();
-                        c.extend(v).expect("r1 matches what r1_matches found");
-                        children.push(c);
-                    }
-                }
-                if rules.r2 {
-                    for (_, m) in g.r2_matches() {
-                        let mut c = g.clone();
-                        c.combine(m).expect("r2 matches what r2_matches found");
-                        children.push(c);
-                    }
-                }
-                if rules.r2p {
-                    for (_, m) in g.r2p_matches() {
-                        let mut c = g.clone();
-                        c.combine_straight(m)
-                            .expect("r2′ matches what r2p_matches found");
-                        children.push(c);
-                    }
-                }
+                let children = children(&g, rules, n_max);
                 if generated + children.len() > max_graphs {
                     return Err(TooLarge {
                         limit: max_graphs,

@@ -38,6 +38,19 @@ pub(super) struct Ray {
     pub closed_after: bool,
 }
 
+/// The darts of a graph: a dart (v, k) is ray k at v, with its facet counter-clockwise of
+/// it; walking along the crease away from v keeps that facet on the left.
+struct Darts {
+    /// Every living vertex with its rotation.
+    rings: Vec<(Vid, Vec<Ray>)>,
+    /// (position in `rings`, ray index) of every dart.
+    darts: Vec<(usize, usize)>,
+    /// The next dart along the same facet, if the sector at the far end is closed.
+    next: Vec<Option<usize>>,
+    /// Whether some dart leads to this one.
+    has_prev: Vec<bool>,
+}
+
 /// The boundary of one facet, counter-clockwise (the facet on the left).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FacetBoundary {
@@ -360,28 +373,47 @@ impl CreaseGraph {
     /// Every facet's boundary, walked counter-clockwise; an error when the labels around a
     /// vertex disagree or a facet's creases do not form one chain.
     pub fn facet_boundaries(&self) -> Result<Vec<FacetBoundary>, FacetError> {
-        // A dart (v, k): ray k at v, with its facet counter-clockwise of it; walking along
-        // the crease away from v keeps that facet on the left.
         let rings: Vec<(Vid, Vec<Ray>)> = self.vertices().map(|v| (v.vid, self.ring(v))).collect();
-        let pos_of = |v: Vid| rings.iter().position(|(u, _)| *u == v).expect("living");
-        let vname = |v: Vid| format!("v{}", self.name(v).unwrap_or(0));
-        // Labels must agree across every closed sector.
-        for (v, ring) in &rings {
+        self.check_sector_labels(&rings)?;
+        let darts = self.darts(rings);
+        let mut out: Vec<FacetBoundary> = Vec::new();
+        for f in 0..self.facet_names.len() {
+            if let Some(fb) = self.facet_boundary(&darts, FacetId(f as u32))? {
+                out.push(fb);
+            }
+        }
+        Ok(out)
+    }
+
+    /// A vertex as facet errors name it.
+    fn vlabel(&self, v: Vid) -> String {
+        format!("v{}", self.name(v).unwrap_or(0))
+    }
+
+    /// Labels must agree across every closed sector.
+    fn check_sector_labels(&self, rings: &[(Vid, Vec<Ray>)]) -> Result<(), FacetError> {
+        for (v, ring) in rings {
             let n = ring.len();
             for k in 0..n {
                 let (a, b) = (ring[k], ring[(k + 1) % n]);
                 if a.closed_after && self.ccw_side(*v, a.cid) != self.cw_side(*v, b.cid) {
                     return Err(FacetError(format!(
                         "at {} the sector between its creases to {} and {} is one facet but they name {} and {}",
-                        vname(*v),
-                        vname(self.other(*v, a.cid)),
-                        vname(self.other(*v, b.cid)),
+                        self.vlabel(*v),
+                        self.vlabel(self.other(*v, a.cid)),
+                        self.vlabel(self.other(*v, b.cid)),
                         self.facet_name(self.ccw_side(*v, a.cid)),
                         self.facet_name(self.cw_side(*v, b.cid)),
                     )));
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Every dart with its successor along its facet.
+    fn darts(&self, rings: Vec<(Vid, Vec<Ray>)>) -> Darts {
+        let pos_of = |v: Vid| rings.iter().position(|(u, _)| *u == v).expect("living");
         // Successor of a dart: at the far end w, the next ray clockwise from the arriving
         // crease, if the sector between them is closed.
         let mut darts: Vec<(usize, usize)> = Vec::new();
@@ -413,72 +445,79 @@ impl CreaseGraph {
                 has_prev[e] = true;
             }
         }
-        let mut out: Vec<FacetBoundary> = Vec::new();
-        for f in 0..self.facet_names.len() {
-            let f = FacetId(f as u32);
-            let mine: Vec<usize> = (0..darts.len())
-                .filter(|&d| {
-                    let (i, k) = darts[d];
-                    self.ccw_side(rings[i].0, rings[i].1[k].cid) == f
-                })
-                .collect();
-            if mine.is_empty() {
-                continue;
-            }
-            let starts: Vec<usize> = mine.iter().copied().filter(|&d| !has_prev[d]).collect();
-            if starts.len() > 1 {
-                return Err(FacetError(format!(
-                    "facet {} has {} separate boundary pieces (starting at {}); a facet's creases must form one chain",
-                    self.facet_name(f),
-                    starts.len(),
-                    starts
-                        .iter()
-                        .map(|&d| vname(rings[darts[d].0].0))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                )));
-            }
-            let closed = starts.is_empty();
-            let first = starts.first().copied().unwrap_or(mine[0]);
-            let mut fb = FacetBoundary {
-                facet: f,
-                name: self.facet_name(f).to_owned(),
-                vertices: Vec::new(),
-                creases: Vec::new(),
-                closed,
-            };
-            let mut d = first;
-            loop {
+        Darts {
+            rings,
+            darts,
+            next,
+            has_prev,
+        }
+    }
+
+    /// The boundary of facet `f` (`None` when no crease bounds it), or why its creases do
+    /// not form one chain.
+    fn facet_boundary(&self, w: &Darts, f: FacetId) -> Result<Option<FacetBoundary>, FacetError> {
+        let (rings, darts) = (&w.rings, &w.darts);
+        let mine: Vec<usize> = (0..darts.len())
+            .filter(|&d| {
                 let (i, k) = darts[d];
-                let (v, c) = (rings[i].0, rings[i].1[k].cid);
-                fb.vertices.push(v);
-                fb.creases.push(c);
-                match next[d] {
-                    Some(e) if e == first => break,
-                    Some(e) => {
-                        if fb.creases.len() > mine.len() {
-                            break;
-                        }
-                        d = e;
-                    }
-                    None => {
-                        fb.vertices.push(self.other(v, c));
+                self.ccw_side(rings[i].0, rings[i].1[k].cid) == f
+            })
+            .collect();
+        if mine.is_empty() {
+            return Ok(None);
+        }
+        let starts: Vec<usize> = mine.iter().copied().filter(|&d| !w.has_prev[d]).collect();
+        if starts.len() > 1 {
+            return Err(FacetError(format!(
+                "facet {} has {} separate boundary pieces (starting at {}); a facet's creases must form one chain",
+                self.facet_name(f),
+                starts.len(),
+                starts
+                    .iter()
+                    .map(|&d| self.vlabel(rings[darts[d].0].0))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
+        let closed = starts.is_empty();
+        let first = starts.first().copied().unwrap_or(mine[0]);
+        let mut fb = FacetBoundary {
+            facet: f,
+            name: self.facet_name(f).to_owned(),
+            vertices: Vec::new(),
+            creases: Vec::new(),
+            closed,
+        };
+        let mut d = first;
+        loop {
+            let (i, k) = darts[d];
+            let (v, c) = (rings[i].0, rings[i].1[k].cid);
+            fb.vertices.push(v);
+            fb.creases.push(c);
+            match w.next[d] {
+                Some(e) if e == first => break,
+                Some(e) => {
+                    if fb.creases.len() > mine.len() {
                         break;
                     }
+                    d = e;
+                }
+                None => {
+                    fb.vertices.push(self.other(v, c));
+                    break;
                 }
             }
-            if fb.creases.len() != mine.len() {
-                return Err(FacetError(format!(
-                    "facet {} is bounded by {} crease sides but its chain from {} covers {}: its creases do not form one chain",
-                    self.facet_name(f),
-                    mine.len(),
-                    vname(rings[darts[first].0].0),
-                    fb.creases.len()
-                )));
-            }
-            out.push(fb);
         }
-        Ok(out)
+        if fb.creases.len() != mine.len() {
+            return Err(FacetError(format!(
+                "facet {} is bounded by {} crease sides but its chain from {} covers {}: its creases do not form one chain",
+                self.facet_name(f),
+                mine.len(),
+                self.vlabel(rings[darts[first].0].0),
+                fb.creases.len()
+            )));
+        }
+        Ok(Some(fb))
     }
 
     /// Whether crease `c` still has the direction its placement gave it (seen from `at`):

@@ -84,6 +84,7 @@ mod enumerate;
 mod graph;
 mod notation;
 mod rules;
+mod step;
 mod straight;
 
 pub use canon::Code;
@@ -92,13 +93,16 @@ pub use enumerate::{
     TooLarge, dot_header, dot_node,
 };
 pub use graph::{CreaseGraph, FacetBoundary, FacetError};
-pub use notation::{NotationError, Step, format_sequence, parse_sequence};
+pub use notation::{NotationError, format_sequence, parse_sequence};
 pub use rules::{R2Match, RuleError};
+pub use step::Step;
 pub use straight::StraightSink;
 
 use serde::{Deserialize, Serialize};
 
 use crate::task::Drive;
+/// The vertex type T of the thesis (defined with G0, which the task file types).
+pub use crate::task::VertexType;
 
 /// Stable vertex id: never reused, independent of the shifting names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
@@ -126,15 +130,6 @@ impl Cid {
     fn ix(self) -> usize {
         self.0 as usize
     }
-}
-
-/// The vertex type T of the thesis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum VertexType {
-    /// χ: can be extended by r1 (and combined by r2).
-    Extendable,
-    /// ∅: a source, a vertex already extended, or a G0 vertex the user marked terminal.
-    Terminal,
 }
 
 /// A vertex and its label.

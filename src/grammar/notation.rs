@@ -2,33 +2,11 @@
 //! r1 on v3, r2 on v4 and v8, … with the names as they are when each rule applies. A primed
 //! pair is r2′ (Sec. 5.7, Fig. 52b): `2, 3, 4, 8, (9, 14)'` (`′` is read as `'`).
 
-use std::fmt;
-
+use super::StepRecord;
 use super::graph::CreaseGraph;
-use super::{StepRecord, rules::RuleError};
+use super::rules::RuleError;
+use super::step::Step;
 use crate::task::Task;
-
-/// One rule application in the notation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Step {
-    /// r1 on the vertex with this name.
-    Extend(usize),
-    /// r2 on the two vertices with these names, written sorted (the larger first only in
-    /// the rare case where both roles match and the second one is meant).
-    Combine(usize, usize),
-    /// r2′ on the two vertices with these names (written as r2's pairs, with a prime).
-    Straight(usize, usize),
-}
-
-impl fmt::Display for Step {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Step::Extend(n) => write!(f, "{n}"),
-            Step::Combine(a, b) => write!(f, "({a}, {b})"),
-            Step::Straight(a, b) => write!(f, "({a}, {b})'"),
-        }
-    }
-}
 
 /// A sequence string that does not parse, or a step that does not apply.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]

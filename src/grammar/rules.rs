@@ -4,10 +4,10 @@
 use petgraph::algo::has_path_connecting;
 
 use super::graph::CreaseGraph;
-use super::notation::Step;
+use super::step::Step;
 use super::{
     Cid, ConstraintSpec, Crease, CreaseOrigin, Created, FacetId, Placement, R1Record, R2Record,
-    StepRecord, Substitution, VarId, VarKind, Variable, VertexType, Vid,
+    StepRecord, Substitution, VarId, VarKind, Variable, Vertex, VertexType, Vid,
 };
 
 /// A rule that does not apply, with the reason.
@@ -37,6 +37,78 @@ pub(super) enum NoR2 {
     SharedPred(Vid),
     BothG0,
     Ancestor(Vid, Vid),
+}
+
+/// The vertex r1 extends and what every crease it adds is placed from.
+struct R1Parent {
+    /// The extended vertex.
+    a: Vid,
+    /// Its name when extended.
+    aname: usize,
+    /// Index of this r1 step.
+    step: usize,
+    /// The tail of its last incoming crease p_m.
+    ref_pm: Vid,
+    /// The tail of its first incoming crease p_1.
+    ref_p1: Vid,
+    /// Its s1, when G0 gave it one.
+    s1: Option<Cid>,
+}
+
+/// Eq. 31–33 for r1 at `a` with incoming creases p1 … pm and slots `s`. The sectors next to
+/// new creases are variables, except the one no placement measures: the remainder (between
+/// s2 and s3, or between s1 and s2 when only s1 is new and s2 existed: `remainder_s1_s2`).
+fn r1_constraints(
+    a: Vid,
+    (p1, pm): (Cid, Cid),
+    s: [Cid; 3],
+    sector_of: [Option<VarId>; 3],
+    remainder_s1_s2: bool,
+    created: &[Created],
+) -> Vec<ConstraintSpec> {
+    let mut constraints = Vec::new();
+    if let Some(var) = sector_of[0] {
+        constraints.push(ConstraintSpec::Sector {
+            vertex: a,
+            from: pm,
+            to: s[0],
+            var: Some(var),
+        });
+    }
+    if let Some(var) = sector_of[1] {
+        constraints.push(ConstraintSpec::Sector {
+            vertex: a,
+            from: s[0],
+            to: s[1],
+            var: Some(var),
+        });
+    }
+    if let Some(var) = sector_of[2] {
+        constraints.push(ConstraintSpec::Sector {
+            vertex: a,
+            from: s[2],
+            to: p1,
+            var: Some(var),
+        });
+    }
+    let (rf, rt) = if remainder_s1_s2 {
+        (s[0], s[1])
+    } else {
+        (s[1], s[2])
+    };
+    constraints.push(ConstraintSpec::Remainder {
+        vertex: a,
+        from: rf,
+        to: rt,
+    });
+    for c in created {
+        constraints.push(ConstraintSpec::Length {
+            crease: c.crease,
+            var: Some(c.placement.length),
+        });
+    }
+    constraints.push(ConstraintSpec::RigidFoldability { vertex: a });
+    constraints
 }
 
 impl CreaseGraph {
@@ -75,20 +147,7 @@ impl CreaseGraph {
         let step = self.steps.len();
         let aname = self.name(a).expect("living");
         let v = self.vx(a).clone();
-        let scenario = match v.slots.map(|s| s.is_some()) {
-            [false, false, false] => 1,
-            [false, false, true] => 2,
-            [true, false, false] => 3,
-            [false, true, true] => 4,
-            [true, false, true] => 5,
-            [true, true, false] => 6,
-            _ => {
-                return Err(RuleError(format!(
-                    "r1 does not match {}: its existing outgoing creases leave no single open sector",
-                    self.vname(a)
-                )));
-            }
-        };
+        let scenario = self.r1_scenario(a, &v)?;
         let missing: Vec<usize> = (0..3).filter(|&k| v.slots[k].is_none()).collect();
         let (first, last) = (missing[0], missing[missing.len() - 1]);
         let (p1, pm) = (v.preds[0], v.preds[v.preds.len() - 1]);
@@ -104,152 +163,39 @@ impl CreaseGraph {
         } else {
             self.cw_side(a, slot(last + 1))
         };
-        let ref_pm = self.cr(pm).tail;
-        let ref_p1 = self.cr(p1).tail;
+        let at = R1Parent {
+            a,
+            aname,
+            step,
+            ref_pm: self.cr(pm).tail,
+            ref_p1: self.cr(p1).tail,
+            s1: v.slots[0],
+        };
 
         let mut slots = v.slots;
         let mut created = Vec::new();
         let mut variables = Vec::new();
         let mut sector_of = [None::<VarId>; 3];
         for (i, &k) in missing.iter().enumerate() {
-            let vid = Vid(self.node_of.len() as u32);
-            let vname = self.order.len() + 1;
-            let cid = Cid(self.edge_of.len() as u32);
-            let sector = self.new_var(VarKind::Sector, format!("α_{vname}"), step, cid, vid);
-            let length = self.new_var(
-                VarKind::Length,
-                format!("l_{aname},{vname}"),
-                step,
-                cid,
-                vid,
+            let last_new = i + 1 == missing.len();
+            let (c, left) = self.r1_crease(
+                &at,
+                k,
+                sector_of[0],
+                last_new.then_some(after_facet),
+                right_facet,
             );
-            variables.extend([sector, length]);
+            // The crease's own sector is the last its placement sums.
+            let sector = *c.placement.sectors.last().expect("a sector");
+            variables.extend([sector, c.placement.length]);
             sector_of[k] = Some(sector);
-            let placement = match k {
-                0 => Placement {
-                    parent: a,
-                    reference: ref_pm,
-                    sign: 1.0,
-                    sectors: vec![sector],
-                    length,
-                },
-                1 => match v.slots[0] {
-                    Some(s1) => Placement {
-                        parent: a,
-                        reference: self.cr(s1).head,
-                        sign: 1.0,
-                        sectors: vec![sector],
-                        length,
-                    },
-                    None => Placement {
-                        parent: a,
-                        reference: ref_pm,
-                        sign: 1.0,
-                        sectors: vec![sector_of[0].expect("s1 created first"), sector],
-                        length,
-                    },
-                },
-                _ => Placement {
-                    parent: a,
-                    reference: ref_p1,
-                    sign: -1.0,
-                    sectors: vec![sector],
-                    length,
-                },
-            };
-            let left = if i + 1 == missing.len() {
-                after_facet
-            } else {
-                self.new_facet()
-            };
-            let node = self.g.add_node(super::Vertex {
-                vid,
-                preds: vec![cid],
-                slots: [None; 3],
-                ty: VertexType::Extendable,
-                extended: false,
-                g0: None,
-                g0_coords: None,
-                placement: Some(placement.clone()),
-                sink_between: None,
-            });
-            self.node_of.push(Some(node));
-            self.order.push(vid);
-            let e = self.g.add_edge(
-                self.node_of[a.ix()].expect("living"),
-                node,
-                Crease {
-                    cid,
-                    tail: a,
-                    head: vid,
-                    left,
-                    right: right_facet,
-                    origin: CreaseOrigin::Extension {
-                        step,
-                        slot: k as u8 + 1,
-                        sector,
-                        length,
-                        created: vid,
-                    },
-                },
-            );
-            self.edge_of.push(e);
             right_facet = left;
-            slots[k] = Some(cid);
-            created.push(Created {
-                slot: k as u8 + 1,
-                vertex: vid,
-                crease: cid,
-                placement,
-            });
+            slots[k] = Some(c.crease);
+            created.push(c);
         }
-
-        // Eq. 31–33. The sectors next to new creases are variables, except the one no
-        // placement measures: the remainder (between s2 and s3, or between s1 and s2 when
-        // only s1 is new and s2 existed).
         let s = slots.map(|c| c.expect("all slots filled"));
-        let mut constraints = Vec::new();
-        if let Some(var) = sector_of[0] {
-            constraints.push(ConstraintSpec::Sector {
-                vertex: a,
-                from: pm,
-                to: s[0],
-                var: Some(var),
-            });
-        }
-        if let Some(var) = sector_of[1] {
-            constraints.push(ConstraintSpec::Sector {
-                vertex: a,
-                from: s[0],
-                to: s[1],
-                var: Some(var),
-            });
-        }
-        if let Some(var) = sector_of[2] {
-            constraints.push(ConstraintSpec::Sector {
-                vertex: a,
-                from: s[2],
-                to: p1,
-                var: Some(var),
-            });
-        }
-        let (rf, rt) = if sector_of[0].is_some() && v.slots[1].is_some() {
-            (s[0], s[1])
-        } else {
-            (s[1], s[2])
-        };
-        constraints.push(ConstraintSpec::Remainder {
-            vertex: a,
-            from: rf,
-            to: rt,
-        });
-        for c in &created {
-            constraints.push(ConstraintSpec::Length {
-                crease: c.crease,
-                var: Some(c.placement.length),
-            });
-        }
-        constraints.push(ConstraintSpec::RigidFoldability { vertex: a });
+        let remainder_s1_s2 = sector_of[0].is_some() && v.slots[1].is_some();
+        let constraints = r1_constraints(a, (p1, pm), s, sector_of, remainder_s1_s2, &created);
 
         let va = self.vx_mut(a);
         va.slots = slots;
@@ -265,6 +211,125 @@ impl CreaseGraph {
             constraints,
         }));
         Ok(())
+    }
+
+    /// Scenario r1,1 … r1,6 (Tables 1–2) from the slots G0 already filled at `a`.
+    fn r1_scenario(&self, a: Vid, v: &Vertex) -> Result<u8, RuleError> {
+        Ok(match v.slots.map(|s| s.is_some()) {
+            [false, false, false] => 1,
+            [false, false, true] => 2,
+            [true, false, false] => 3,
+            [false, true, true] => 4,
+            [true, false, true] => 5,
+            [true, true, false] => 6,
+            _ => {
+                return Err(RuleError(format!(
+                    "r1 does not match {}: its existing outgoing creases leave no single open sector",
+                    self.vname(a)
+                )));
+            }
+        })
+    }
+
+    /// r1's new crease in slot `k` (0-based) of `at.a`, with its new vertex, its sector and
+    /// length variables and its placement (Eq. 28). `s1_sector`: the sector variable of an
+    /// s1 created in the same application; `left`: the facet on its left, `None` for a new
+    /// one. Returns what was created and the facet on its left.
+    fn r1_crease(
+        &mut self,
+        at: &R1Parent,
+        k: usize,
+        s1_sector: Option<VarId>,
+        left: Option<FacetId>,
+        right: FacetId,
+    ) -> (Created, FacetId) {
+        let (a, step) = (at.a, at.step);
+        let vid = Vid(self.node_of.len() as u32);
+        let vname = self.order.len() + 1;
+        let cid = Cid(self.edge_of.len() as u32);
+        let sector = self.new_var(VarKind::Sector, format!("α_{vname}"), step, cid, vid);
+        let length = self.new_var(
+            VarKind::Length,
+            format!("l_{},{vname}", at.aname),
+            step,
+            cid,
+            vid,
+        );
+        let placement = match k {
+            0 => Placement {
+                parent: a,
+                reference: at.ref_pm,
+                sign: 1.0,
+                sectors: vec![sector],
+                length,
+            },
+            1 => match at.s1 {
+                Some(s1) => Placement {
+                    parent: a,
+                    reference: self.cr(s1).head,
+                    sign: 1.0,
+                    sectors: vec![sector],
+                    length,
+                },
+                None => Placement {
+                    parent: a,
+                    reference: at.ref_pm,
+                    sign: 1.0,
+                    sectors: vec![s1_sector.expect("s1 created first"), sector],
+                    length,
+                },
+            },
+            _ => Placement {
+                parent: a,
+                reference: at.ref_p1,
+                sign: -1.0,
+                sectors: vec![sector],
+                length,
+            },
+        };
+        let left = match left {
+            Some(f) => f,
+            None => self.new_facet(),
+        };
+        let node = self.g.add_node(Vertex {
+            vid,
+            preds: vec![cid],
+            slots: [None; 3],
+            ty: VertexType::Extendable,
+            extended: false,
+            g0: None,
+            g0_coords: None,
+            placement: Some(placement.clone()),
+            sink_between: None,
+        });
+        self.node_of.push(Some(node));
+        self.order.push(vid);
+        let e = self.g.add_edge(
+            self.node_of[a.ix()].expect("living"),
+            node,
+            Crease {
+                cid,
+                tail: a,
+                head: vid,
+                left,
+                right,
+                origin: CreaseOrigin::Extension {
+                    step,
+                    slot: k as u8 + 1,
+                    sector,
+                    length,
+                    created: vid,
+                },
+            },
+        );
+        self.edge_of.push(e);
+        let created = Created {
+            slot: k as u8 + 1,
+            vertex: vid,
+            crease: cid,
+            placement,
+        };
+        (created, left)
     }
 
     fn new_var(
@@ -548,7 +613,7 @@ impl CreaseGraph {
     /// match: the second is written with the names swapped.
     pub(super) fn pair_matches(
         &self,
-        eligible: impl Fn(&super::Vertex) -> bool,
+        eligible: impl Fn(&Vertex) -> bool,
         ok: impl Fn(Vid, Vid) -> bool,
         step: fn(usize, usize) -> Step,
     ) -> Vec<(Step, R2Match)> {

@@ -25,8 +25,8 @@
 //! from the coordinates (Eq. 35), exactly as for r2.
 
 use super::graph::CreaseGraph;
-use super::notation::Step;
 use super::rules::NoR2;
+use super::step::Step;
 use super::{
     ConstraintSpec, FacetId, R2Match, R2Record, RuleError, StepRecord, Straight, Vertex,
     VertexType, Vid,

@@ -118,6 +118,15 @@ impl Drive {
     }
 }
 
+/// Most solver iterations one reported step may spend on refinement, by default
+/// ([`SolverSettings::refine_budget`]). A step that follows
+/// a branch refines along one path; near a flat or singular state that can take a few
+/// hundred thousand (352,111 for the last step of the gripper's g06-c2-uu at N_max = 2,
+/// seed 1), so the budget is several times that. A motion that no step size can follow
+/// would otherwise refine every half down to `max_refine`, 2^18 substeps: hours, found
+/// by fuzzing.
+pub const REFINE_ITERATION_BUDGET: usize = 2_000_000;
+
 /// Stopping rules of the per-step least-squares solve, and the step control.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SolverSettings {
@@ -142,7 +151,7 @@ pub struct SolverSettings {
     /// its branch; the cross-validation allows 18.
     pub max_refine: usize,
     /// Most solver iterations one reported step may spend on refinement (default
-    /// [`super::run::REFINE_ITERATION_BUDGET`]); where it stops, the step is taken as it
+    /// [`REFINE_ITERATION_BUDGET`]); where it stops, the step is taken as it
     /// stands and reported as capped.
     pub refine_budget: usize,
 }
@@ -156,7 +165,7 @@ impl Default for SolverSettings {
             residual_tolerance: 1e-15,
             max_correction: f64::INFINITY,
             max_refine: 6,
-            refine_budget: super::run::REFINE_ITERATION_BUDGET,
+            refine_budget: REFINE_ITERATION_BUDGET,
         }
     }
 }
@@ -377,6 +386,41 @@ impl SimInput {
     /// Check the input and resolve the supports.
     pub(crate) fn resolve(&self) -> Result<Supports, InputError> {
         let n = self.initial.len();
+        self.check_numbers_and_indices()?;
+        if self.drives.is_empty() {
+            return Err(InputError::NoDrive);
+        }
+        let mut roles = Roles {
+            role: vec![None; n],
+            why: vec![String::new(); n],
+        };
+        for &v in &self.fixed {
+            check_vertex("the fixed list".into(), v, n)?;
+            roles.assign(v, Source::Fixed, "fixed".into(), true)?;
+        }
+        for (k, d) in self.drives.iter().enumerate() {
+            match d {
+                Drive::Trajectory { vertex, path } => {
+                    self.trajectory(k, *vertex, path, &mut roles)?;
+                }
+                Drive::Crease {
+                    p,
+                    q,
+                    fixed_face,
+                    moving_face,
+                    angle,
+                } => {
+                    let faces = [*fixed_face, *moving_face];
+                    self.crease_drive(k, (*p, *q), faces, angle, &mut roles)?;
+                }
+            }
+        }
+        Ok(Supports { role: roles.role })
+    }
+
+    /// Steps, finite numbers, vertex indices in range and facets of distinct vertices.
+    fn check_numbers_and_indices(&self) -> Result<(), InputError> {
+        let n = self.initial.len();
         if self.steps == 0 {
             return Err(InputError::NoSteps(0));
         }
@@ -392,20 +436,9 @@ impl SimInput {
                 return Err(InputError::NonFinite { what: what.into() });
             }
         }
-        let check_v = |what: String, v: usize| {
-            if v >= n {
-                Err(InputError::VertexOutOfRange {
-                    what,
-                    vertex: v,
-                    count: n,
-                })
-            } else {
-                Ok(())
-            }
-        };
         for (f, face) in self.faces.iter().enumerate() {
             for &v in face {
-                check_v(format!("facet {f}"), v)?;
+                check_vertex(format!("facet {f}"), v, n)?;
             }
             let mut s = face.clone();
             s.sort_unstable();
@@ -415,143 +448,174 @@ impl SimInput {
             }
         }
         for (k, b) in self.extra_bars.iter().enumerate() {
-            check_v(format!("extra bar {k}"), b[0])?;
-            check_v(format!("extra bar {k}"), b[1])?;
+            check_vertex(format!("extra bar {k}"), b[0], n)?;
+            check_vertex(format!("extra bar {k}"), b[1], n)?;
         }
         for &(v, off) in &self.first_step_offsets {
-            check_v("a first-step offset".into(), v)?;
+            check_vertex("a first-step offset".into(), v, n)?;
             if off.iter().any(|x| !x.is_finite()) {
                 return Err(InputError::NonFinite {
                     what: format!("first-step offset of vertex {v}"),
                 });
             }
         }
-        if self.drives.is_empty() {
-            return Err(InputError::NoDrive);
+        Ok(())
+    }
+
+    /// Drive `k`: `vertex` follows `path`, which must start at the vertex.
+    fn trajectory(
+        &self,
+        k: usize,
+        vertex: usize,
+        path: &PathFn,
+        roles: &mut Roles,
+    ) -> Result<(), InputError> {
+        check_vertex(format!("drive {k}"), vertex, self.initial.len())?;
+        let at = path(self.t_start);
+        let init = self.initial[vertex];
+        let gap = (0..3).map(|i| (at[i] - init[i]).abs()).fold(0.0, f64::max);
+        let scale = init.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
+        if gap.is_nan() || gap > 1e-9 * scale {
+            return Err(InputError::DriveStartMismatch {
+                what: format!("trajectory of vertex {vertex} (drive {k})"),
+                t_start: self.t_start,
+                prescribed: fmt3(at),
+                actual: fmt3(init),
+            });
         }
-        let mut role: Vec<Option<Source>> = vec![None; n];
-        let mut why: Vec<String> = vec![String::new(); n];
-        let mut assign = |v: usize, src: Source, label: String, allow_fixed_twice: bool| {
-            if let Some(old) = &role[v] {
-                let both_fixed = matches!(old, Source::Fixed) && matches!(src, Source::Fixed);
-                if both_fixed && allow_fixed_twice {
-                    return Ok(());
-                }
-                return Err(InputError::Conflict {
-                    vertex: v,
-                    first: why[v].clone(),
-                    second: label,
+        roles.assign(
+            vertex,
+            Source::Path(path.clone()),
+            format!("driven by trajectory (drive {k})"),
+            false,
+        )
+    }
+
+    /// Drive `k`: crease p–q folds by `angle`, facet `fixed_face` held, `moving_face`
+    /// turning about the crease; the angle must start at the pattern's.
+    fn crease_drive(
+        &self,
+        k: usize,
+        (p, q): (usize, usize),
+        [fixed_face, moving_face]: [usize; 2],
+        angle: &AngleFn,
+        roles: &mut Roles,
+    ) -> Result<(), InputError> {
+        let n = self.initial.len();
+        check_vertex(format!("crease drive {k}"), p, n)?;
+        check_vertex(format!("crease drive {k}"), q, n)?;
+        for f in [fixed_face, moving_face] {
+            if f >= self.faces.len() {
+                return Err(InputError::FaceOutOfRange {
+                    what: format!("crease drive {k}"),
+                    face: f,
+                    count: self.faces.len(),
                 });
             }
-            role[v] = Some(src);
-            why[v] = label;
-            Ok(())
+        }
+        let (fa, fb) = (&self.faces[fixed_face], &self.faces[moving_face]);
+        let not_crease = InputError::NotACrease {
+            p,
+            q,
+            fixed_face,
+            moving_face,
         };
-        for &v in &self.fixed {
-            check_v("the fixed list".into(), v)?;
-            assign(v, Source::Fixed, "fixed".into(), true)?;
+        if fixed_face == moving_face {
+            return Err(not_crease);
         }
-        for (k, d) in self.drives.iter().enumerate() {
-            match d {
-                Drive::Trajectory { vertex, path } => {
-                    check_v(format!("drive {k}"), *vertex)?;
-                    let at = path(self.t_start);
-                    let init = self.initial[*vertex];
-                    let gap = (0..3).map(|i| (at[i] - init[i]).abs()).fold(0.0, f64::max);
-                    let scale = init.iter().fold(1.0_f64, |m, x| m.max(x.abs()));
-                    if gap.is_nan() || gap > 1e-9 * scale {
-                        return Err(InputError::DriveStartMismatch {
-                            what: format!("trajectory of vertex {vertex} (drive {k})"),
-                            t_start: self.t_start,
-                            prescribed: fmt3(at),
-                            actual: fmt3(init),
-                        });
-                    }
-                    assign(
-                        *vertex,
-                        Source::Path(path.clone()),
-                        format!("driven by trajectory (drive {k})"),
-                        false,
-                    )?;
-                }
-                Drive::Crease {
-                    p,
-                    q,
-                    fixed_face,
-                    moving_face,
-                    angle,
-                } => {
-                    check_v(format!("crease drive {k}"), *p)?;
-                    check_v(format!("crease drive {k}"), *q)?;
-                    for f in [*fixed_face, *moving_face] {
-                        if f >= self.faces.len() {
-                            return Err(InputError::FaceOutOfRange {
-                                what: format!("crease drive {k}"),
-                                face: f,
-                                count: self.faces.len(),
-                            });
-                        }
-                    }
-                    let (fa, fb) = (&self.faces[*fixed_face], &self.faces[*moving_face]);
-                    let not_crease = InputError::NotACrease {
-                        p: *p,
-                        q: *q,
-                        fixed_face: *fixed_face,
-                        moving_face: *moving_face,
-                    };
-                    if fixed_face == moving_face {
-                        return Err(not_crease);
-                    }
-                    // Orient the crease so that the fixed facet is on its left (it runs p→q).
-                    let (p, q) = if traverses(fa, *p, *q) && traverses(fb, *q, *p) {
-                        (*p, *q)
-                    } else if traverses(fa, *q, *p) && traverses(fb, *p, *q) {
-                        (*q, *p)
-                    } else {
-                        return Err(not_crease);
-                    };
-                    let angle0 = crease_angle(&self.initial, p, q, fa, fb);
-                    let a0 = angle(self.t_start);
-                    if (a0 - angle0).is_nan() || (a0 - angle0).abs() > 1e-9 {
-                        return Err(InputError::DriveStartMismatch {
-                            what: format!("crease drive {k} ({p}–{q})"),
-                            t_start: self.t_start,
-                            prescribed: format!("fold angle {a0:.9}"),
-                            actual: format!("fold angle {angle0:.9}"),
-                        });
-                    }
-                    let origin = Vector3::from(self.initial[p]);
-                    let e = Vector3::from(self.initial[q]) - origin;
-                    // With the fixed facet A on the left of ê, the fold angle grows when the
-                    // right facet turns by −Δ about ê (see check::self_intersection).
-                    let axis = Unit::new_normalize(-e);
-                    for &v in fa {
-                        assign(
-                            v,
-                            Source::Fixed,
-                            format!("on the fixed facet of crease drive {k}"),
-                            true,
-                        )?;
-                    }
-                    for &v in fb {
-                        if v == p || v == q {
-                            continue;
-                        }
-                        assign(
-                            v,
-                            Source::Rotate {
-                                origin,
-                                axis,
-                                angle: angle.clone(),
-                                angle0,
-                            },
-                            format!("on the moving facet of crease drive {k}"),
-                            false,
-                        )?;
-                    }
-                }
+        // Orient the crease so that the fixed facet is on its left (it runs p→q).
+        let (p, q) = if traverses(fa, p, q) && traverses(fb, q, p) {
+            (p, q)
+        } else if traverses(fa, q, p) && traverses(fb, p, q) {
+            (q, p)
+        } else {
+            return Err(not_crease);
+        };
+        let angle0 = crease_angle(&self.initial, p, q, fa, fb);
+        let a0 = angle(self.t_start);
+        if (a0 - angle0).is_nan() || (a0 - angle0).abs() > 1e-9 {
+            return Err(InputError::DriveStartMismatch {
+                what: format!("crease drive {k} ({p}–{q})"),
+                t_start: self.t_start,
+                prescribed: format!("fold angle {a0:.9}"),
+                actual: format!("fold angle {angle0:.9}"),
+            });
+        }
+        let origin = Vector3::from(self.initial[p]);
+        let e = Vector3::from(self.initial[q]) - origin;
+        // With the fixed facet A on the left of ê, the fold angle grows when the
+        // right facet turns by −Δ about ê (see check::self_intersection).
+        let axis = Unit::new_normalize(-e);
+        for &v in fa {
+            roles.assign(
+                v,
+                Source::Fixed,
+                format!("on the fixed facet of crease drive {k}"),
+                true,
+            )?;
+        }
+        for &v in fb {
+            if v == p || v == q {
+                continue;
             }
+            roles.assign(
+                v,
+                Source::Rotate {
+                    origin,
+                    axis,
+                    angle: angle.clone(),
+                    angle0,
+                },
+                format!("on the moving facet of crease drive {k}"),
+                false,
+            )?;
         }
-        Ok(Supports { role })
+        Ok(())
+    }
+}
+
+/// Vertex index `v` of `what` is below the vertex count `n`.
+fn check_vertex(what: String, v: usize, n: usize) -> Result<(), InputError> {
+    if v >= n {
+        Err(InputError::VertexOutOfRange {
+            what,
+            vertex: v,
+            count: n,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+/// The supports being resolved: each vertex's source and why it has it.
+struct Roles {
+    role: Vec<Option<Source>>,
+    why: Vec<String>,
+}
+
+impl Roles {
+    /// Give vertex `v` its source; a second one is a conflict, except fixing a fixed vertex
+    /// again where `allow_fixed_twice`.
+    fn assign(
+        &mut self,
+        v: usize,
+        src: Source,
+        label: String,
+        allow_fixed_twice: bool,
+    ) -> Result<(), InputError> {
+        if let Some(old) = &self.role[v] {
+            let both_fixed = matches!(old, Source::Fixed) && matches!(src, Source::Fixed);
+            if both_fixed && allow_fixed_twice {
+                return Ok(());
+            }
+            return Err(InputError::Conflict {
+                vertex: v,
+                first: self.why[v].clone(),
+                second: label,
+            });
+        }
+        self.role[v] = Some(src);
+        self.why[v] = label;
+        Ok(())
     }
 }

@@ -3,6 +3,8 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+// The default refinement budget lives with the settings it is the default of.
+pub use super::input::REFINE_ITERATION_BUDGET;
 use super::input::{InputError, SimInput, Supports};
 use super::solver::{Bars, predict, solve};
 use crate::check::{CheckError, Checker, Intersection, StateTracker};
@@ -89,15 +91,6 @@ impl SimReport {
 /// Largest disagreement (relative to the pattern's size) between reaching a state in one
 /// step and in two half steps before the step is refined.
 pub const BRANCH_TOLERANCE: f64 = 1e-4;
-
-/// Most solver iterations one reported step may spend on refinement, by default
-/// ([`super::SolverSettings::refine_budget`]). A step that follows
-/// a branch refines along one path; near a flat or singular state that can take a few
-/// hundred thousand (352,111 for the last step of the gripper's g06-c2-uu at N_max = 2,
-/// seed 1), so the budget is several times that. A motion that no step size can follow
-/// would otherwise refine every half down to `max_refine`, 2^18 substeps: hours, found
-/// by fuzzing.
-pub const REFINE_ITERATION_BUDGET: usize = 2_000_000;
 
 /// Takes one reported step by continuation.
 ///

@@ -205,32 +205,7 @@ pub fn solve(
         if r.iter().all(|v| v.abs() <= s.residual_tolerance) {
             break;
         }
-        // Normal equations: A = JᵀJ, g = Jᵀr, bar by bar.
-        a.fill(0.0);
-        g.fill(0.0);
-        for (&[i, j], &rb) in bars.pairs.iter().zip(&r) {
-            let d = [
-                2.0 * (x[i][0] - x[j][0]),
-                2.0 * (x[i][1] - x[j][1]),
-                2.0 * (x[i][2] - x[j][2]),
-            ];
-            // ∂r/∂x_i = d, ∂r/∂x_j = −d.
-            let blocks = [(slot[i], 1.0), (slot[j], -1.0)];
-            for &(si, sgi) in &blocks {
-                let Some(ki) = si else { continue };
-                for u in 0..3 {
-                    g[3 * ki + u] += sgi * d[u] * rb;
-                }
-                for &(sj, sgj) in &blocks {
-                    let Some(kj) = sj else { continue };
-                    for u in 0..3 {
-                        for w in 0..3 {
-                            a[(3 * ki + u, 3 * kj + w)] += sgi * sgj * d[u] * d[w];
-                        }
-                    }
-                }
-            }
-        }
+        normal_equations(bars, slot, x, &r, &mut a, &mut g);
         if g.amax() == 0.0 {
             break; // stationary (e.g. a symmetric saddle); nothing more to gain
         }
@@ -255,15 +230,7 @@ pub fn solve(
             };
             let h = chol.solve(&(-&g));
             let hmax = h.amax();
-            for (v, slot_v) in slot.iter().enumerate() {
-                if let Some(k) = slot_v {
-                    for u in 0..3 {
-                        trial[v][u] = x[v][u] + h[3 * k + u];
-                    }
-                } else {
-                    trial[v] = x[v];
-                }
-            }
+            stepped(slot, x, &h, &mut trial);
             let r_new = residuals(&trial);
             let cost_new = cost_of(&r_new);
             let predicted = 0.5 * h.dot(&(&h * mu - &g));
@@ -299,6 +266,55 @@ pub fn solve(
     SolveStats {
         iterations: it,
         cost,
+    }
+}
+
+/// The normal equations at `x` with residuals `r`: `a = JᵀJ`, `g = Jᵀr`, bar by bar.
+fn normal_equations(
+    bars: &Bars,
+    slot: &[Option<usize>],
+    x: &[[f64; 3]],
+    r: &[f64],
+    a: &mut DMatrix<f64>,
+    g: &mut DVector<f64>,
+) {
+    a.fill(0.0);
+    g.fill(0.0);
+    for (&[i, j], &rb) in bars.pairs.iter().zip(r) {
+        let d = [
+            2.0 * (x[i][0] - x[j][0]),
+            2.0 * (x[i][1] - x[j][1]),
+            2.0 * (x[i][2] - x[j][2]),
+        ];
+        // ∂r/∂x_i = d, ∂r/∂x_j = −d.
+        let blocks = [(slot[i], 1.0), (slot[j], -1.0)];
+        for &(si, sgi) in &blocks {
+            let Some(ki) = si else { continue };
+            for u in 0..3 {
+                g[3 * ki + u] += sgi * d[u] * rb;
+            }
+            for &(sj, sgj) in &blocks {
+                let Some(kj) = sj else { continue };
+                for u in 0..3 {
+                    for w in 0..3 {
+                        a[(3 * ki + u, 3 * kj + w)] += sgi * sgj * d[u] * d[w];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// `trial` = `x` with the free coordinates moved by `h`.
+fn stepped(slot: &[Option<usize>], x: &[[f64; 3]], h: &DVector<f64>, trial: &mut [[f64; 3]]) {
+    for (v, slot_v) in slot.iter().enumerate() {
+        if let Some(k) = slot_v {
+            for u in 0..3 {
+                trial[v][u] = x[v][u] + h[3 * k + u];
+            }
+        } else {
+            trial[v] = x[v];
+        }
     }
 }
 

@@ -1,14 +1,23 @@
-//! The initial graph G0: checked, with the counter-clockwise crease order around every
-//! vertex derived from the coordinates and the facet labels.
+//! The initial graph G0: its file format, checked, with the counter-clockwise crease order
+//! around every vertex derived from the coordinates and the facet labels ([`super::rotation`]).
 
 use std::collections::HashMap;
-use std::sync::Arc;
 
 use petgraph::algo::{connected_components, toposort};
 use petgraph::graph::DiGraph;
+use serde::{Deserialize, Serialize};
 
-use super::{Ctx, Drive, RawInitial, TaskError};
-use crate::grammar::{CreaseGraph, VertexType};
+use super::rotation::{order_vertex, ring_at};
+use super::{Ctx, Drive, Number, TaskError};
+
+/// The vertex type T of the thesis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum VertexType {
+    /// χ: can be extended by r1 (and combined by r2).
+    Extendable,
+    /// ∅: a source, a vertex already extended, or a G0 vertex the user marked terminal.
+    Terminal,
+}
 
 /// A vertex of G0.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,17 +78,69 @@ pub struct MirrorMap {
     pub facet: Vec<usize>,
 }
 
-/// Angles closer than this are one direction (two creases on top of each other).
-const ANGLE_EPS: f64 = 1e-9;
+// ---------------------------------------------------------------------------------------
+// Raw file format (serde): `[initial_graph]`.
 
-pub(crate) fn build(
-    cx: &Ctx<'_>,
-    raw: &RawInitial,
-    mirror_xz: bool,
-) -> Result<InitialGraph, TaskError> {
-    let vf = |i: usize| format!("initial_graph.vertices[{i}]");
-    let cf = |i: usize| format!("initial_graph.creases[{i}]");
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawInitial {
+    #[serde(default)]
+    pub(crate) vertices: Vec<RawVertex>,
+    #[serde(default)]
+    pub(crate) creases: Vec<RawCrease>,
+}
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawVertex {
+    pub(crate) id: String,
+    pub(crate) xy: Vec<Number>,
+    #[serde(rename = "type")]
+    pub(crate) ty: RawType,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+pub(crate) enum RawType {
+    #[serde(rename = "extendable", alias = "chi", alias = "χ")]
+    Extendable,
+    #[serde(rename = "terminal", alias = "none", alias = "∅")]
+    Terminal,
+}
+
+impl From<RawType> for VertexType {
+    fn from(t: RawType) -> Self {
+        match t {
+            RawType::Extendable => VertexType::Extendable,
+            RawType::Terminal => VertexType::Terminal,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawCrease {
+    pub(crate) from: String,
+    pub(crate) to: String,
+    pub(crate) left: String,
+    pub(crate) right: String,
+    pub(crate) drive: Option<String>,
+}
+
+// ---------------------------------------------------------------------------------------
+// Checks.
+
+fn vf(i: usize) -> String {
+    format!("initial_graph.vertices[{i}]")
+}
+
+fn cf(i: usize) -> String {
+    format!("initial_graph.creases[{i}]")
+}
+
+/// G0 checked on its own, with the crease order around every vertex, and the distance
+/// below which two of its positions are one. Its facet labels and mirror image are checked
+/// against the grammar's graph afterwards (`Task::from_toml_str`); `mirror` is `None` here.
+pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial) -> Result<(InitialGraph, f64), TaskError> {
     if raw.vertices.is_empty() {
         return Err(cx.err(
             "initial_graph.vertices",
@@ -92,8 +153,31 @@ pub(crate) fn build(
             "no creases: G0 needs at least one crease",
         ));
     }
+    let (mut vertices, index) = vertices(cx, raw)?;
+    let tol = distinct_positions(cx, &vertices)?;
+    let (creases, facets) = creases(cx, raw, &index)?;
+    check_drives(cx, &vertices, &creases, raw)?;
+    check_topology(cx, &vertices, &creases)?;
 
-    // Vertices: unique ids, finite and distinct coordinates.
+    // The counter-clockwise order around every vertex.
+    for vi in 0..vertices.len() {
+        let ring = ring_at(cx, &vertices, &creases, vi)?;
+        order_vertex(cx, &mut vertices, &creases, &facets, vi, ring)?;
+    }
+    let g = InitialGraph {
+        vertices,
+        creases,
+        facets,
+        mirror: None,
+    };
+    Ok((g, tol))
+}
+
+/// The vertices (unique ids, finite coordinates, no order yet) and their index by id.
+fn vertices<'r>(
+    cx: &Ctx<'_>,
+    raw: &'r RawInitial,
+) -> Result<(Vec<InitialVertex>, HashMap<&'r str, usize>), TaskError> {
     let mut index: HashMap<&str, usize> = HashMap::new();
     let mut vertices = Vec::with_capacity(raw.vertices.len());
     for (i, v) in raw.vertices.iter().enumerate() {
@@ -123,6 +207,12 @@ pub(crate) fn build(
             ring: Vec::new(),
         });
     }
+    Ok((vertices, index))
+}
+
+/// Checks that no two vertices share a position; returns the tolerance used (scaled to G0's
+/// extent).
+fn distinct_positions(cx: &Ctx<'_>, vertices: &[InitialVertex]) -> Result<f64, TaskError> {
     let scale = vertices
         .iter()
         .map(|v| v.xy[0].abs().max(v.xy[1].abs()))
@@ -142,8 +232,16 @@ pub(crate) fn build(
             }
         }
     }
+    Ok(tol)
+}
 
-    // Creases: known, distinct endpoints; one crease per pair; two different facets.
+/// The creases (known, distinct endpoints; one crease per pair; two different facets; a
+/// parsed drive) and the facet names in order of first appearance.
+fn creases(
+    cx: &Ctx<'_>,
+    raw: &RawInitial,
+    index: &HashMap<&str, usize>,
+) -> Result<(Vec<InitialCrease>, Vec<String>), TaskError> {
     let mut facets: Vec<String> = Vec::new();
     let mut facet_ix = |name: &str, field: String| -> Result<usize, TaskError> {
         if name.trim().is_empty() {
@@ -213,7 +311,17 @@ pub(crate) fn build(
             drive,
         });
     }
+    Ok((creases, facets))
+}
 
+/// Extendable vertices have incoming creases; exactly the creases leaving terminal
+/// vertices are driven.
+fn check_drives(
+    cx: &Ctx<'_>,
+    vertices: &[InitialVertex],
+    creases: &[InitialCrease],
+    raw: &RawInitial,
+) -> Result<(), TaskError> {
     // An extendable vertex needs incoming creases: r1 places new creases from p1 and pm.
     for (i, v) in vertices.iter().enumerate() {
         if v.ty == VertexType::Extendable && !creases.iter().any(|c| c.head == i) {
@@ -248,11 +356,18 @@ pub(crate) fn build(
             _ => {}
         }
     }
+    Ok(())
+}
 
-    // Topology: acyclic, connected, fewer than three successors.
+/// Topology: acyclic, connected, fewer than three successors.
+fn check_topology(
+    cx: &Ctx<'_>,
+    vertices: &[InitialVertex],
+    creases: &[InitialCrease],
+) -> Result<(), TaskError> {
     let mut dg: DiGraph<(), ()> = DiGraph::new();
     let nodes: Vec<_> = (0..vertices.len()).map(|_| dg.add_node(())).collect();
-    for c in &creases {
+    for c in creases {
         dg.add_edge(nodes[c.tail], nodes[c.head], ());
     }
     if let Err(cycle) = toposort(&dg, None) {
@@ -267,7 +382,7 @@ pub(crate) fn build(
         let mut stack = vec![0];
         while let Some(v) = stack.pop() {
             if !std::mem::replace(&mut seen[v], true) {
-                for c in &creases {
+                for c in creases {
                     if c.tail == v {
                         stack.push(c.head);
                     } else if c.head == v {
@@ -291,242 +406,5 @@ pub(crate) fn build(
             ));
         }
     }
-
-    // The counter-clockwise order around every vertex.
-    for vi in 0..vertices.len() {
-        let ring = ring_at(cx, &vertices, &creases, vi)?;
-        order_vertex(cx, &mut vertices, &creases, &facets, vi, ring)?;
-    }
-
-    let mut g = InitialGraph {
-        vertices,
-        creases,
-        facets,
-        mirror: None,
-    };
-
-    // Facets: every facet's boundary must be one chain (closed, or open at the paper's edge).
-    let graph = CreaseGraph::from_initial(Arc::new(g.clone()));
-    if let Err(e) = graph.facet_boundaries() {
-        return Err(cx.err(
-            "initial_graph.creases",
-            format!("inconsistent facet labels: {e}"),
-        ));
-    }
-    if !mirror_xz {
-        return Ok(g);
-    }
-    g.mirror = Some(mirror_map(cx, &g.vertices, &g.creases, &g.facets, tol)?);
-    let graph = CreaseGraph::from_initial(Arc::new(g.clone()));
-    if g.mirror.is_some() && graph.mirror_code().as_ref() != Some(&graph.canonical_code()) {
-        return Err(cx.err(
-            "symmetry.mirror_xz",
-            "the mirror image of G0 orders its creases differently from G0 (check the facet labels of creases on the x-axis)",
-        ));
-    }
-    Ok(g)
-}
-
-/// The facet on the counter-clockwise / clockwise side of crease `c` seen from vertex `v`.
-fn sides(c: &InitialCrease, v: usize) -> (usize, usize) {
-    if c.tail == v {
-        (c.left, c.right)
-    } else {
-        (c.right, c.left)
-    }
-}
-
-/// Incident creases sorted counter-clockwise by direction.
-fn ring_at(
-    cx: &Ctx<'_>,
-    vs: &[InitialVertex],
-    cs: &[InitialCrease],
-    v: usize,
-) -> Result<Vec<usize>, TaskError> {
-    let p = vs[v].xy;
-    let mut rays: Vec<(f64, usize)> = cs
-        .iter()
-        .enumerate()
-        .filter(|(_, c)| c.tail == v || c.head == v)
-        .map(|(i, c)| {
-            let o = vs[if c.tail == v { c.head } else { c.tail }].xy;
-            ((o[1] - p[1]).atan2(o[0] - p[0]), i)
-        })
-        .collect();
-    rays.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for k in 1..rays.len() {
-        if rays[k].0 - rays[k - 1].0 < ANGLE_EPS {
-            let (a, b) = (&cs[rays[k - 1].1], &cs[rays[k].1]);
-            return Err(cx.err(
-                "initial_graph.creases",
-                format!(
-                    "creases {}→{} and {}→{} leave vertex \"{}\" in the same direction",
-                    vs[a.tail].id, vs[a.head].id, vs[b.tail].id, vs[b.head].id, vs[v].id
-                ),
-            ));
-        }
-    }
-    Ok(rays.into_iter().map(|r| r.1).collect())
-}
-
-/// Derive preds (p1 … pm), slots and the ring of vertex `v` from its ccw ring.
-fn order_vertex(
-    cx: &Ctx<'_>,
-    vs: &mut [InitialVertex],
-    cs: &[InitialCrease],
-    facets: &[String],
-    v: usize,
-    ring: Vec<usize>,
-) -> Result<(), TaskError> {
-    let n = ring.len();
-    // Sector k lies counter-clockwise from ring[k] to ring[k+1]; it is closed when one facet
-    // fills it, i.e. both creases name the same facet on that side.
-    let open: Vec<usize> = (0..n)
-        .filter(|&k| sides(&cs[ring[k]], v).0 != sides(&cs[ring[(k + 1) % n]], v).1)
-        .collect();
-    let id = vs[v].id.clone();
-    let field = format!("initial_graph.vertices[{v}]");
-    let is_in = |c: usize| cs[c].head == v;
-    let start = open.first().map_or(0, |&k| (k + 1) % n);
-    let rotated: Vec<usize> = (0..n).map(|k| ring[(start + k) % n]).collect();
-
-    if vs[v].ty == VertexType::Terminal {
-        // Never extended or combined: any consistent arrangement is fine.
-        let preds: Vec<usize> = rotated.iter().copied().filter(|&c| is_in(c)).collect();
-        let outs: Vec<usize> = rotated.iter().copied().filter(|&c| !is_in(c)).collect();
-        let mut slots = [None; 3];
-        for (k, c) in outs.into_iter().enumerate() {
-            slots[k] = Some(c);
-        }
-        let vx = &mut vs[v];
-        // The true ccw order, for facet walks; preds and slots are storage only here.
-        vx.ring = rotated;
-        vx.preds = preds;
-        vx.slots = slots;
-        return Ok(());
-    }
-
-    if !rotated.iter().any(|&c| is_in(c)) {
-        return Err(cx.err(
-            format!("{field}.type"),
-            format!("vertex \"{id}\" has no incoming crease (a source) and cannot be extendable: make it \"terminal\""),
-        ));
-    }
-    let names = |k: usize| {
-        let (a, b) = (sides(&cs[ring[k]], v).0, sides(&cs[ring[(k + 1) % n]], v).1);
-        format!("{} | {}", facets[a], facets[b])
-    };
-    match open.len() {
-        1 => {}
-        0 => {
-            return Err(cx.err(
-                format!("{field}.type"),
-                format!("every sector around extendable vertex \"{id}\" is closed by one facet, so new creases have nowhere to go; make it \"terminal\" or fix the facet labels"),
-            ));
-        }
-        k => {
-            return Err(cx.err(
-                "initial_graph.creases",
-                format!(
-                    "inconsistent facet labels around extendable vertex \"{id}\": {k} sectors are open ({}); it needs exactly one open sector, where its new creases go",
-                    open.iter().map(|&s| names(s)).collect::<Vec<_>>().join("; ")
-                ),
-            ));
-        }
-    }
-    // After the open sector, going ccw: [outgoing before p1 (… s3)] p1 … pm [s1 (s2) after pm].
-    let first_in = rotated.iter().position(|&c| is_in(c)).unwrap_or(0);
-    let last_in = rotated.iter().rposition(|&c| is_in(c)).unwrap_or(0);
-    if rotated[first_in..=last_in].iter().any(|&c| !is_in(c)) {
-        return Err(cx.err(
-            "initial_graph.creases",
-            format!("at extendable vertex \"{id}\" an outgoing crease lies between incoming ones; its incoming creases must be adjacent (rotation p1 … pm s1 s2 s3)"),
-        ));
-    }
-    let after_gap = &rotated[..first_in];
-    let preds = rotated[first_in..=last_in].to_vec();
-    let before_gap = &rotated[last_in + 1..];
-    let mut slots = [None; 3];
-    for (k, &c) in before_gap.iter().enumerate() {
-        slots[k] = Some(c);
-    }
-    for (k, &c) in after_gap.iter().rev().enumerate() {
-        slots[2 - k] = Some(c);
-    }
-    let vx = &mut vs[v];
-    vx.ring = preds
-        .iter()
-        .chain(slots.iter().flatten())
-        .copied()
-        .collect();
-    vx.preds = preds;
-    vx.slots = slots;
     Ok(())
-}
-
-fn mirror_map(
-    cx: &Ctx<'_>,
-    vs: &[InitialVertex],
-    cs: &[InitialCrease],
-    facets: &[String],
-    tol: f64,
-) -> Result<MirrorMap, TaskError> {
-    let field = "symmetry.mirror_xz";
-    let mut vertex = Vec::with_capacity(vs.len());
-    for v in vs {
-        let m = vs
-            .iter()
-            .position(|u| (u.xy[0] - v.xy[0]).abs() <= tol && (u.xy[1] + v.xy[1]).abs() <= tol);
-        let Some(m) = m else {
-            return Err(cx.err(
-                field,
-                format!("G0 is not symmetric about the x-axis: no vertex at the mirror position ({}, {}) of \"{}\"", v.xy[0], -v.xy[1], v.id),
-            ));
-        };
-        if vs[m].ty != v.ty {
-            return Err(cx.err(
-                field,
-                format!(
-                    "G0 is not symmetric: \"{}\" and its mirror image \"{}\" have different types",
-                    v.id, vs[m].id
-                ),
-            ));
-        }
-        vertex.push(m);
-    }
-    let mut facet = vec![usize::MAX; facets.len()];
-    for c in cs {
-        let Some(m) = cs
-            .iter()
-            .find(|d| d.tail == vertex[c.tail] && d.head == vertex[c.head])
-        else {
-            return Err(cx.err(
-                field,
-                format!(
-                    "G0 is not symmetric: crease {} → {} has no mirror image",
-                    vs[c.tail].id, vs[c.head].id
-                ),
-            ));
-        };
-        if c.drive != m.drive {
-            return Err(cx.err(
-                field,
-                format!(
-                    "G0 is not symmetric: crease {} → {} and its mirror image have different drives",
-                    vs[c.tail].id, vs[c.head].id
-                ),
-            ));
-        }
-        // Mirroring swaps left and right.
-        for (f, g) in [(c.left, m.right), (c.right, m.left)] {
-            if facet[f] != usize::MAX && facet[f] != g {
-                return Err(cx.err(
-                    field,
-                    format!("G0's facet labels are not mirror-symmetric: facet {} maps to both {} and {}", facets[f], facets[facet[f]], facets[g]),
-                ));
-            }
-            facet[f] = g;
-        }
-    }
-    Ok(MirrorMap { vertex, facet })
 }

@@ -1,0 +1,106 @@
+//! The `[check]` table: the intersection check's states and obstacles (Sec. 5.4.2).
+
+use serde::Deserialize;
+
+use super::{Ctx, Number, TaskError};
+
+/// A cylinder obstacle (axis segment `a → b` and radius): the checks' own type, so the
+/// task, the intersection check and the pictures share one definition.
+pub use crate::check::Cylinder;
+
+/// Intersection-check setup.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckSpec {
+    /// Number of evenly spaced states over [0, t_max] to check (the thesis uses 16).
+    pub states: usize,
+    /// Cylindrical obstacles.
+    pub cylinders: Vec<Cylinder>,
+    /// The design is one arm of a two-armed device: checks and pictures include a copy
+    /// rotated 180° about the z-axis (the gripper, Sec. 5.5.1).
+    pub second_arm: bool,
+    /// Number of evenly spaced states over [0, t_max] at which the optimizer imposes the
+    /// clearance and margin constraints (more are added where a finer sweep finds the
+    /// design closer than allowed).
+    pub optimize_states: usize,
+}
+
+/// Default of `[check] optimize_states`.
+pub const DEFAULT_OPTIMIZE_STATES: usize = 9;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawCheck {
+    states: i64,
+    #[serde(default)]
+    cylinders: Vec<RawCylinder>,
+    #[serde(default)]
+    second_arm: bool,
+    optimize_states: Option<i64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCylinder {
+    radius: Number,
+    from: Vec<Number>,
+    to: Vec<Number>,
+}
+
+pub(crate) fn build(cx: &Ctx<'_>, raw: Option<&RawCheck>) -> Result<Option<CheckSpec>, TaskError> {
+    let Some(c) = raw else { return Ok(None) };
+    let max = crate::limits::STATES_MAX as i64;
+    if !(2..=max).contains(&c.states) {
+        return Err(cx.err(
+            "check.states",
+            format!(
+                "{} is not allowed: at least 2 states (0 and t_max), at most {max}",
+                c.states
+            ),
+        ));
+    }
+    let optimize_states = c.optimize_states.unwrap_or(DEFAULT_OPTIMIZE_STATES as i64);
+    if !(2..=crate::limits::STATES_MAX as i64).contains(&optimize_states) {
+        return Err(cx.err(
+            "check.optimize_states",
+            format!(
+                "{optimize_states} is not allowed: at least 2 states (0 and t_max), at most {}",
+                crate::limits::STATES_MAX
+            ),
+        ));
+    }
+    let mut cylinders = Vec::new();
+    for (i, cy) in c.cylinders.iter().enumerate() {
+        cylinders.push(cylinder(cx, i, cy)?);
+    }
+    Ok(Some(CheckSpec {
+        states: c.states as usize,
+        cylinders,
+        second_arm: c.second_arm,
+        optimize_states: optimize_states as usize,
+    }))
+}
+
+/// Obstacle `i`: a positive radius, an axis of two distinct points.
+fn cylinder(cx: &Ctx<'_>, i: usize, cy: &RawCylinder) -> Result<Cylinder, TaskError> {
+    let f = format!("check.cylinders[{i}]");
+    let radius = cx.num(&format!("{f}.radius"), &cy.radius)?;
+    if radius <= 0.0 {
+        return Err(cx.err(
+            format!("{f}.radius"),
+            format!("{radius} is not allowed: the radius must be > 0"),
+        ));
+    }
+    let from = cx.point(&format!("{f}.from"), &cy.from)?;
+    let to = cx.point(&format!("{f}.to"), &cy.to)?;
+    if from == to {
+        return Err(cx.err(
+            format!("{f}.to"),
+            "the axis end equals its start: the axis needs two distinct points",
+        ));
+    }
+    Ok(Cylinder {
+        a: from,
+        b: to,
+        radius,
+    })
+}

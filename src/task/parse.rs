@@ -1,0 +1,163 @@
+//! Reading a task file table by table. [`Draft::parse`] reads the file and checks the
+//! name, `[grammar]`, `[symmetry]` and G0 on its own; `Task::from_toml_str` then checks G0
+//! against the grammar's graph (which this module cannot see: the grammar reads the task);
+//! [`Draft::finish`] checks every other table, each in its own module (a raw serde struct
+//! and a `build` function), in a fixed order: the first error found is the one reported. A
+//! new table is a module, a field of `RawTask` and one line in `finish`.
+
+use serde::Deserialize;
+
+use super::ctx::syntax_error;
+use super::{
+    Ctx, InitialGraph, N_MAX_LIMIT, Symmetry, Task, TaskError, VertexType, bounds, check,
+    constraints, digest, initial, motion, objective, robustness,
+};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawTask {
+    name: Option<String>,
+    description: Option<String>,
+    grammar: RawGrammar,
+    #[serde(default)]
+    symmetry: RawSymmetry,
+    initial_graph: initial::RawInitial,
+    motion: Option<motion::RawMotion>,
+    bounds: Option<bounds::RawBounds>,
+    objective: Option<objective::RawObjective>,
+    check: Option<check::RawCheck>,
+    robustness: Option<robustness::RawRobustness>,
+    constraints: Option<constraints::RawConstraints>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawGrammar {
+    n_max: i64,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawSymmetry {
+    #[serde(default)]
+    mirror_xz: bool,
+}
+
+/// A task file read up to G0's crease order.
+pub(crate) struct Draft<'a> {
+    pub(crate) cx: Ctx<'a>,
+    text: &'a str,
+    raw: RawTask,
+    name: String,
+    n_max: usize,
+    pub(crate) symmetry: Symmetry,
+    /// G0 with its crease order; its mirror map is filled in by `Task::from_toml_str`.
+    pub(crate) initial: InitialGraph,
+    /// Distance below which two positions of G0 are one.
+    pub(crate) tol: f64,
+}
+
+impl<'a> Draft<'a> {
+    /// Parse `text` (`file` labels the messages) and check the name, N_max, the symmetry
+    /// and G0 on its own.
+    pub(crate) fn parse(text: &'a str, file: &'a str) -> Result<Draft<'a>, TaskError> {
+        let cx = Ctx { file };
+        if let Some(kind) = crate::text::other_kind(text, "task") {
+            return Err(cx.err("(file)", kind));
+        }
+        let raw: RawTask = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
+        let name = raw.name.clone().unwrap_or_default();
+        check_name(&name).map_err(|m| cx.err("name", m))?;
+
+        let n_max = raw.grammar.n_max;
+        if !(1..=N_MAX_LIMIT as i64).contains(&n_max) {
+            return Err(cx.err(
+                "grammar.n_max",
+                format!(
+                    "{n_max} is out of range: allowed 1..={N_MAX_LIMIT} (at least one vertex to extend; the number of graphs grows about twentyfold per internal vertex)"
+                ),
+            ));
+        }
+        let symmetry = Symmetry {
+            mirror_xz: raw.symmetry.mirror_xz,
+        };
+        let (initial, tol) = initial::build(&cx, &raw.initial_graph)?;
+        Ok(Draft {
+            cx,
+            text,
+            raw,
+            name,
+            n_max: n_max as usize,
+            symmetry,
+            initial,
+            tol,
+        })
+    }
+
+    /// Check the remaining tables and assemble the task.
+    pub(crate) fn finish(self) -> Result<Task, TaskError> {
+        let Draft {
+            cx,
+            text,
+            raw,
+            name,
+            n_max,
+            symmetry,
+            initial,
+            tol: _,
+        } = self;
+        if !initial
+            .vertices
+            .iter()
+            .any(|v| v.ty == VertexType::Extendable)
+        {
+            return Err(cx.err(
+                "initial_graph.vertices",
+                "no vertex has type = \"extendable\": the grammar extends only extendable (χ) vertices, so this G0 generates no crease pattern",
+            ));
+        }
+        let motion = motion::build(&cx, raw.motion.as_ref())?;
+        let bounds = bounds::build(&cx, raw.bounds.as_ref())?;
+        let objective = objective::build(&cx, raw.objective.as_ref(), motion)?;
+        let check = check::build(&cx, raw.check.as_ref())?;
+        let robustness = robustness::build(&cx, raw.robustness.as_ref(), &initial)?;
+
+        Ok(Task {
+            name: name.trim().to_string(),
+            digest: digest(text.as_bytes()),
+            description: raw.description,
+            source: None,
+            initial,
+            n_max,
+            symmetry,
+            motion,
+            bounds,
+            objective,
+            check,
+            robustness,
+            kawasaki: constraints::kawasaki(raw.constraints.as_ref()),
+        })
+    }
+}
+
+/// Why `name` cannot name a task (it names the output directory `out/<name>`).
+fn check_name(name: &str) -> Result<(), String> {
+    let shown = crate::text::excerpt(name, 40);
+    let max = crate::limits::NAME_MAX;
+    if name.chars().count() > max {
+        return Err(format!(
+            "\"{shown}\" is longer than {max} characters (the name becomes a directory name)"
+        ));
+    }
+    if name.contains(['/', '\\']) || name.chars().any(char::is_control) {
+        return Err(format!(
+            "{shown:?}: a task name may not contain path separators or control characters (it becomes the directory out/<name>)"
+        ));
+    }
+    if name.contains("..") || name.trim() == "." {
+        return Err(format!(
+            "{shown:?}: a task name may not contain \"..\" or be \".\" (it becomes the directory out/<name>)"
+        ));
+    }
+    Ok(())
+}
