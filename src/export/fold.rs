@@ -163,23 +163,8 @@ pub fn to_fold_string(p: &Pattern, meta: &DesignMeta, spec: FoldSpec) -> super::
     validate_pattern(p)?;
     validate_meta(meta, p)?;
     let assign = assignments(p);
-    // Boundary edges have no fold angle: `null`, as Origami Simulator writes them (it
-    // draws a line with opacity |angle|/180, so 0 would hide the boundary).
-    let angles_deg = |f: Option<&Frame>| -> Vec<Option<f64>> {
-        p.edges
-            .iter()
-            .enumerate()
-            .map(|(i, e)| match e.kind {
-                EdgeKind::Boundary => None,
-                EdgeKind::Crease { .. } => {
-                    Some(f.map_or(0.0, |f| wrap(f.fold_angles[i]).to_degrees()))
-                }
-            })
-            .collect()
-    };
-    let final_angles = angles_deg(p.frames.last());
+    let final_angles = angles_deg(p, p.frames.last());
     let mut top: Vec<(String, String)> = Vec::new();
-    let put = |k: &str, v: Value, indent: usize| (k.to_string(), render_value(&v, indent));
     let title = if meta.rule_sequence.is_empty() {
         meta.task.clone()
     } else {
@@ -200,6 +185,36 @@ pub fn to_fold_string(p: &Pattern, meta: &DesignMeta, spec: FoldSpec) -> super::
     top.push(put("edges_assignment", json!(asg), 2));
     top.push(put("edges_foldAngle", json!(final_angles), 2));
     top.push(put("faces_vertices", json!(p.faces), 2));
+    put_foldsynth_fields(&mut top, p, meta);
+    if !p.frames.is_empty() {
+        top.push(("file_frames".into(), file_frames(p)));
+    }
+    let mut s = render_object(&top, 0);
+    s.push('\n');
+    Ok(s)
+}
+
+/// A field of the top level: its key and its value rendered at `indent`.
+fn put(k: &str, v: Value, indent: usize) -> (String, String) {
+    (k.to_string(), render_value(&v, indent))
+}
+
+/// The fold angles (degrees) of frame `f` (`None`: the flat state, all 0). Boundary edges
+/// have no fold angle: `null`, as Origami Simulator writes them (it draws a line with
+/// opacity |angle|/180, so 0 would hide the boundary).
+fn angles_deg(p: &Pattern, f: Option<&Frame>) -> Vec<Option<f64>> {
+    p.edges
+        .iter()
+        .enumerate()
+        .map(|(i, e)| match e.kind {
+            EdgeKind::Boundary => None,
+            EdgeKind::Crease { .. } => Some(f.map_or(0.0, |f| wrap(f.fold_angles[i]).to_degrees())),
+        })
+        .collect()
+}
+
+/// foldsynth's own fields of the top level (see the module docs), in their order.
+fn put_foldsynth_fields(top: &mut Vec<(String, String)>, p: &Pattern, meta: &DesignMeta) {
     let driven: Vec<bool> = p
         .edges
         .iter()
@@ -231,39 +246,35 @@ pub fn to_fold_string(p: &Pattern, meta: &DesignMeta, spec: FoldSpec) -> super::
     if !meta.extra.is_empty() {
         top.push(put("foldsynth:extra", json!(meta.extra), 2));
     }
-    if !p.frames.is_empty() {
-        let frames: Vec<String> = p
-            .frames
-            .iter()
-            .map(|f| {
-                let angles = angles_deg(Some(f));
-                let entries = vec![
-                    (
-                        "frame_title".to_string(),
-                        render_value(&json!(format!("t = {}", f.t)), 6),
-                    ),
-                    (
-                        "frame_classes".into(),
-                        render_value(&json!(["foldedForm"]), 6),
-                    ),
-                    ("frame_attributes".into(), render_value(&json!(["3D"]), 6)),
-                    ("frame_parent".into(), "0".into()),
-                    ("frame_inherit".into(), "true".into()),
-                    ("vertices_coords".into(), render_value(&json!(f.coords), 6)),
-                    ("edges_foldAngle".into(), render_value(&json!(angles), 6)),
-                    ("foldsynth:t".into(), render_value(&json!(f.t), 6)),
-                ];
-                format!("    {}", render_object(&entries, 4))
-            })
-            .collect();
-        top.push((
-            "file_frames".into(),
-            format!("[\n{}\n  ]", frames.join(",\n")),
-        ));
-    }
-    let mut s = render_object(&top, 0);
-    s.push('\n');
-    Ok(s)
+}
+
+/// The value of `file_frames`: one folded form per frame, inheriting the key frame's mesh.
+fn file_frames(p: &Pattern) -> String {
+    let frames: Vec<String> = p
+        .frames
+        .iter()
+        .map(|f| {
+            let angles = angles_deg(p, Some(f));
+            let entries = vec![
+                (
+                    "frame_title".to_string(),
+                    render_value(&json!(format!("t = {}", f.t)), 6),
+                ),
+                (
+                    "frame_classes".into(),
+                    render_value(&json!(["foldedForm"]), 6),
+                ),
+                ("frame_attributes".into(), render_value(&json!(["3D"]), 6)),
+                ("frame_parent".into(), "0".into()),
+                ("frame_inherit".into(), "true".into()),
+                ("vertices_coords".into(), render_value(&json!(f.coords), 6)),
+                ("edges_foldAngle".into(), render_value(&json!(angles), 6)),
+                ("foldsynth:t".into(), render_value(&json!(f.t), 6)),
+            ];
+            format!("    {}", render_object(&entries, 4))
+        })
+        .collect();
+    format!("[\n{}\n  ]", frames.join(",\n"))
 }
 
 /// One frame of a FOLD file after inheritance, with the key frame's mesh.
@@ -455,246 +466,39 @@ impl FoldFile {
                 format!("expected a JSON object at the top, found {}", kind(&root)),
             )
         })?;
-
-        let spec = match top.get("file_spec") {
-            None => None,
-            Some(v) => Some(cx.number(v, "file_spec")?),
-        };
-        let creator = match top.get("file_creator") {
-            None => None,
-            Some(v) => Some(
-                v.as_str()
-                    .ok_or_else(|| {
-                        cx.err(
-                            "file_creator",
-                            format!("expected a string, found {}", kind(v)),
-                        )
-                    })?
-                    .to_string(),
-            ),
-        };
-        if let Some(v) = top.get("file_classes") {
-            cx.strings(v, "file_classes")?;
-        }
-
-        // Raw frames: the key frame is the top level without file_* keys.
-        let mut raw: Vec<(String, Map<String, Value>)> = Vec::new();
-        let key: Map<String, Value> = top
-            .iter()
-            .filter(|(k, _)| !k.starts_with("file_"))
-            .map(|(k, v)| (k.clone(), v.clone()))
-            .collect();
-        raw.push((String::new(), key));
-        if let Some(ff) = top.get("file_frames") {
-            for (i, f) in cx.array(ff, "file_frames")?.iter().enumerate() {
-                let obj = f.as_object().ok_or_else(|| {
-                    cx.err(
-                        format!("file_frames[{i}]"),
-                        format!("expected an object, found {}", kind(f)),
-                    )
-                })?;
-                raw.push((format!("file_frames[{i}]."), obj.clone()));
-            }
-        }
+        let (spec, creator) = parse_header(&cx, top)?;
+        let raw = raw_frames(&cx, top)?;
         let resolved = resolve_inheritance(&cx, &raw)?;
 
         // Mesh from the key frame.
-        let (p0, key) = (&raw[0].0, &resolved[0]);
-        let coords0 = parse_coords(&cx, key, p0)?;
-        let n = coords0.0.len();
-        let mut faces = match key.get("faces_vertices") {
-            Some(v) => Some(parse_faces(&cx, v, &format!("{p0}faces_vertices"), n)?),
-            None => None,
-        };
-        let mut edges = match key.get("edges_vertices") {
-            Some(v) => Some(parse_edges(&cx, v, &format!("{p0}edges_vertices"), n)?),
-            None => None,
-        };
-        let ne = edges.as_ref().map(Vec::len);
-        let assignment = match key.get("edges_assignment") {
-            None => None,
-            Some(v) => {
-                let ne = ne.ok_or_else(|| {
-                    cx.err(
-                        "edges_assignment",
-                        "present without edges_vertices (which edge is which?)",
-                    )
-                })?;
-                Some(parse_assignment(&cx, v, "edges_assignment", ne)?)
-            }
-        };
-        let driven = match top.get("edges_foldsynth:driven") {
-            None => None,
-            Some(v) => {
-                let a = cx.array(v, "edges_foldsynth:driven")?;
-                if Some(a.len()) != ne {
-                    return Err(cx.err(
-                        "edges_foldsynth:driven",
-                        format!(
-                            "{} entries, expected one per edge ({})",
-                            a.len(),
-                            ne.unwrap_or(0)
-                        ),
-                    ));
-                }
-                Some(
-                    a.iter()
-                        .enumerate()
-                        .map(|(i, b)| {
-                            b.as_bool().ok_or_else(|| {
-                                cx.err(format!("edges_foldsynth:driven[{i}]"), "expected a boolean")
-                            })
-                        })
-                        .collect::<Result<Vec<_>, _>>()?,
-                )
-            }
-        };
-
-        let mut edges_derived = false;
-        let mut faces_derived = false;
-        let assignment_derived = assignment.is_none();
-        let assignment = match (&mut edges, &mut faces) {
-            (None, None) => {
-                return Err(cx.err(
-                    "faces_vertices",
-                    "missing, and so is edges_vertices: the file needs at least one of them",
-                ));
-            }
-            (Some(e), None) => {
-                let asg = assignment.unwrap_or_else(|| vec![Assignment::U; e.len()]);
-                if !coords0.0.iter().all(|c| c[2] == 0.0) {
-                    return Err(cx.err(
-                        "faces_vertices",
-                        "missing, and the key frame is not flat (z ≠ 0), so faces cannot be derived from the planar graph",
-                    ));
-                }
-                let xy: Vec<[f64; 2]> = coords0.0.iter().map(|c| [c[0], c[1]]).collect();
-                let b: Vec<bool> = asg.iter().map(|a| *a == Assignment::B).collect();
-                let f = geom::faces_of_planar_graph(&xy, e, &b).map_err(|m| {
-                    cx.err(
-                        "faces_vertices",
-                        format!("missing and cannot be derived: {m}"),
-                    )
-                })?;
-                if f.is_empty() {
-                    return Err(cx.err(
-                        "faces_vertices",
-                        "missing, and the edges enclose no face (give faces_vertices)",
-                    ));
-                }
-                faces = Some(f);
-                faces_derived = true;
-                asg
-            }
-            (None, Some(f)) => {
-                let (e, asg) = edges_from_faces(f);
-                edges = Some(e);
-                edges_derived = true;
-                asg
-            }
-            (Some(e), Some(_)) => assignment.unwrap_or_else(|| vec![Assignment::U; e.len()]),
-        };
-        let mut assignment = assignment;
-        if assignment_derived && !edges_derived {
-            // No assignment: the boundary is where only one face is (FOLD leaves it
-            // to the reader); every other edge is an unassigned crease.
-            if let (Some(e), Some(f)) = (&edges, &faces) {
-                let adj = EdgeFaces::new(e, f);
-                for (i, a) in assignment.iter_mut().enumerate() {
-                    if adj.left[i].len() + adj.right[i].len() == 1 {
-                        *a = Assignment::B;
-                    }
-                }
-            }
-        }
-        let edges = edges.unwrap_or_default();
-        let faces = faces.unwrap_or_default();
-        let ne = edges.len();
+        let coords0 = parse_coords(&cx, &resolved[0], &raw[0].0)?;
+        let mesh = Mesh::parse(&cx, top, &raw[0].0, &resolved[0], &coords0.0)?;
 
         let mut frames = Vec::with_capacity(raw.len());
-        for (fi, ((prefix, own), res)) in raw.iter().zip(&resolved).enumerate() {
-            let (coords, coords_2d) = if fi == 0 {
+        for (fi, (own, res)) in raw.iter().zip(&resolved).enumerate() {
+            let coords = if fi == 0 {
                 coords0.clone()
             } else {
-                parse_coords(&cx, res, prefix)?
+                parse_coords(&cx, res, &own.0)?
             };
-            if coords.len() != n {
-                return Err(cx.err(
-                    format!("{prefix}vertices_coords"),
-                    format!("{} vertices, but the key frame has {n}; foldsynth compares frames vertex by vertex", coords.len()),
-                ));
-            }
-            if fi > 0 {
-                for (key_name, mine) in [("edges_vertices", "edges"), ("faces_vertices", "faces")] {
-                    if let Some(v) = own.get(key_name)
-                        && Some(v) != resolved[0].get(key_name)
-                    {
-                        return Err(cx.err(
-                            format!("{prefix}{key_name}"),
-                            format!("this frame has its own {mine}, different from the key frame's; every frame must share the key frame's mesh"),
-                        ));
-                    }
-                }
-            }
-            let classes = match res.get("frame_classes") {
-                Some(v) => cx.strings(v, &format!("{prefix}frame_classes"))?,
-                None => Vec::new(),
-            };
-            let angle_key = if res.contains_key("edges_foldAngle") {
-                Some("edges_foldAngle")
-            } else if res.contains_key("edges_foldAngles") {
-                Some("edges_foldAngles")
-            } else {
-                None
-            };
-            let fold_angles = match angle_key {
-                None => None,
-                Some(k) => {
-                    let field = format!("{prefix}{k}");
-                    let a = cx.array(&res[k], &field)?;
-                    if a.len() != ne {
-                        return Err(cx.err(
-                            field,
-                            format!("{} entries, expected one per edge ({ne})", a.len()),
-                        ));
-                    }
-                    let mut out = Vec::with_capacity(ne);
-                    for (i, x) in a.iter().enumerate() {
-                        out.push(if x.is_null() {
-                            None
-                        } else {
-                            let d = cx.number(x, &format!("{field}[{i}]"))?;
-                            if d.abs() > 180.0 {
-                                return Err(cx.err(
-                                    format!("{field}[{i}]"),
-                                    format!("{d} is outside [-180, 180] degrees"),
-                                ));
-                            }
-                            Some(d)
-                        });
-                    }
-                    Some(out)
-                }
-            };
-            let fold_angles_own = angle_key.is_some_and(|k| own.contains_key(k));
-            let t = match res.get("foldsynth:t") {
-                None => None,
-                Some(v) => Some(cx.number(v, &format!("{prefix}foldsynth:t"))?),
-            };
-            frames.push(FoldFrame {
-                classes,
-                coords,
-                coords_2d,
-                fold_angles,
-                fold_angles_own,
-                t,
-            });
+            let key = (fi > 0).then_some(&resolved[0]);
+            let (n, ne) = (coords0.0.len(), mesh.edges.len());
+            frames.push(parse_frame(&cx, own, res, key, coords, n, ne)?);
         }
         let custom = top
             .iter()
             .filter(|(k, _)| k.contains(':'))
             .map(|(k, v)| (k.clone(), v.clone()))
             .collect();
+        let Mesh {
+            edges,
+            assignment,
+            faces,
+            edges_derived,
+            faces_derived,
+            assignment_derived,
+            driven,
+        } = mesh;
         Ok(FoldFile {
             source: source.to_string(),
             spec,
@@ -836,16 +640,336 @@ impl EdgeFaces {
     }
 }
 
-fn resolve_inheritance(
+/// `file_spec` and `file_creator`; `file_classes` is checked to be strings.
+fn parse_header(
     cx: &Ctx,
-    raw: &[(String, Map<String, Value>)],
-) -> Result<Vec<Map<String, Value>>, FoldError> {
+    top: &Map<String, Value>,
+) -> Result<(Option<f64>, Option<String>), FoldError> {
+    let spec = match top.get("file_spec") {
+        None => None,
+        Some(v) => Some(cx.number(v, "file_spec")?),
+    };
+    let creator = match top.get("file_creator") {
+        None => None,
+        Some(v) => Some(
+            v.as_str()
+                .ok_or_else(|| {
+                    cx.err(
+                        "file_creator",
+                        format!("expected a string, found {}", kind(v)),
+                    )
+                })?
+                .to_string(),
+        ),
+    };
+    if let Some(v) = top.get("file_classes") {
+        cx.strings(v, "file_classes")?;
+    }
+    Ok((spec, creator))
+}
+
+/// A frame as the file states it (before inheritance), with the prefix of its fields in
+/// messages (`file_frames[2].`; empty for the key frame).
+type RawFrame = (String, Map<String, Value>);
+
+/// The frames as the file states them: the key frame is the top level without `file_*`
+/// keys, then `file_frames`.
+fn raw_frames(cx: &Ctx, top: &Map<String, Value>) -> Result<Vec<RawFrame>, FoldError> {
+    let mut raw: Vec<RawFrame> = Vec::new();
+    let key: Map<String, Value> = top
+        .iter()
+        .filter(|(k, _)| !k.starts_with("file_"))
+        .map(|(k, v)| (k.clone(), v.clone()))
+        .collect();
+    raw.push((String::new(), key));
+    if let Some(ff) = top.get("file_frames") {
+        for (i, f) in cx.array(ff, "file_frames")?.iter().enumerate() {
+            let obj = f.as_object().ok_or_else(|| {
+                cx.err(
+                    format!("file_frames[{i}]"),
+                    format!("expected an object, found {}", kind(f)),
+                )
+            })?;
+            raw.push((format!("file_frames[{i}]."), obj.clone()));
+        }
+    }
+    Ok(raw)
+}
+
+/// The mesh every frame shares, as the key frame states it or derived (see
+/// [`FoldFile`]'s fields of the same names).
+struct Mesh {
+    edges: Vec<[usize; 2]>,
+    assignment: Vec<Assignment>,
+    faces: Vec<Vec<usize>>,
+    edges_derived: bool,
+    faces_derived: bool,
+    assignment_derived: bool,
+    driven: Option<Vec<bool>>,
+}
+
+impl Mesh {
+    /// The key frame's (resolved: `key`, field prefix `p0`, coordinates `coords0`) faces,
+    /// edges and assignment, what is missing derived; `edges_foldsynth:driven` from `top`.
+    fn parse(
+        cx: &Ctx,
+        top: &Map<String, Value>,
+        p0: &str,
+        key: &Map<String, Value>,
+        coords0: &[[f64; 3]],
+    ) -> Result<Mesh, FoldError> {
+        let n = coords0.len();
+        let faces = match key.get("faces_vertices") {
+            Some(v) => Some(parse_faces(cx, v, &format!("{p0}faces_vertices"), n)?),
+            None => None,
+        };
+        let edges = match key.get("edges_vertices") {
+            Some(v) => Some(parse_edges(cx, v, &format!("{p0}edges_vertices"), n)?),
+            None => None,
+        };
+        let ne = edges.as_ref().map(Vec::len);
+        let assignment = match key.get("edges_assignment") {
+            None => None,
+            Some(v) => {
+                let ne = ne.ok_or_else(|| {
+                    cx.err(
+                        "edges_assignment",
+                        "present without edges_vertices (which edge is which?)",
+                    )
+                })?;
+                Some(parse_assignment(cx, v, "edges_assignment", ne)?)
+            }
+        };
+        let driven = parse_driven(cx, top, ne)?;
+        let mut mesh = Mesh::complete(cx, coords0, edges, faces, assignment)?;
+        mesh.driven = driven;
+        Ok(mesh)
+    }
+
+    /// Derive what the file leaves out: faces from the planar graph, edges from the faces'
+    /// sides, the boundary from the faces (`driven` left `None`).
+    fn complete(
+        cx: &Ctx,
+        coords0: &[[f64; 3]],
+        mut edges: Option<Vec<[usize; 2]>>,
+        mut faces: Option<Vec<Vec<usize>>>,
+        assignment: Option<Vec<Assignment>>,
+    ) -> Result<Mesh, FoldError> {
+        let mut edges_derived = false;
+        let mut faces_derived = false;
+        let assignment_derived = assignment.is_none();
+        let assignment = match (&mut edges, &mut faces) {
+            (None, None) => {
+                return Err(cx.err(
+                    "faces_vertices",
+                    "missing, and so is edges_vertices: the file needs at least one of them",
+                ));
+            }
+            (Some(e), None) => {
+                let asg = assignment.unwrap_or_else(|| vec![Assignment::U; e.len()]);
+                faces = Some(derive_faces(cx, coords0, e, &asg)?);
+                faces_derived = true;
+                asg
+            }
+            (None, Some(f)) => {
+                let (e, asg) = edges_from_faces(f);
+                edges = Some(e);
+                edges_derived = true;
+                asg
+            }
+            (Some(e), Some(_)) => assignment.unwrap_or_else(|| vec![Assignment::U; e.len()]),
+        };
+        let mut assignment = assignment;
+        if assignment_derived && !edges_derived {
+            // No assignment: the boundary is where only one face is (FOLD leaves it
+            // to the reader); every other edge is an unassigned crease.
+            if let (Some(e), Some(f)) = (&edges, &faces) {
+                let adj = EdgeFaces::new(e, f);
+                for (i, a) in assignment.iter_mut().enumerate() {
+                    if adj.left[i].len() + adj.right[i].len() == 1 {
+                        *a = Assignment::B;
+                    }
+                }
+            }
+        }
+        Ok(Mesh {
+            edges: edges.unwrap_or_default(),
+            assignment,
+            faces: faces.unwrap_or_default(),
+            edges_derived,
+            faces_derived,
+            assignment_derived,
+            driven: None,
+        })
+    }
+}
+
+/// `edges_foldsynth:driven`, one boolean per edge (`ne` edges, if the file has edges).
+fn parse_driven(
+    cx: &Ctx,
+    top: &Map<String, Value>,
+    ne: Option<usize>,
+) -> Result<Option<Vec<bool>>, FoldError> {
+    let Some(v) = top.get("edges_foldsynth:driven") else {
+        return Ok(None);
+    };
+    let a = cx.array(v, "edges_foldsynth:driven")?;
+    if Some(a.len()) != ne {
+        return Err(cx.err(
+            "edges_foldsynth:driven",
+            format!(
+                "{} entries, expected one per edge ({})",
+                a.len(),
+                ne.unwrap_or(0)
+            ),
+        ));
+    }
+    a.iter()
+        .enumerate()
+        .map(|(i, b)| {
+            b.as_bool()
+                .ok_or_else(|| cx.err(format!("edges_foldsynth:driven[{i}]"), "expected a boolean"))
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Some)
+}
+
+/// The faces of the planar graph of a flat key frame (`coords0`, all z = 0) with edges
+/// `e`; the edges assigned `B` are the boundary.
+fn derive_faces(
+    cx: &Ctx,
+    coords0: &[[f64; 3]],
+    e: &[[usize; 2]],
+    asg: &[Assignment],
+) -> Result<Vec<Vec<usize>>, FoldError> {
+    if !coords0.iter().all(|c| c[2] == 0.0) {
+        return Err(cx.err(
+            "faces_vertices",
+            "missing, and the key frame is not flat (z ≠ 0), so faces cannot be derived from the planar graph",
+        ));
+    }
+    let xy: Vec<[f64; 2]> = coords0.iter().map(|c| [c[0], c[1]]).collect();
+    let b: Vec<bool> = asg.iter().map(|a| *a == Assignment::B).collect();
+    let f = geom::faces_of_planar_graph(&xy, e, &b).map_err(|m| {
+        cx.err(
+            "faces_vertices",
+            format!("missing and cannot be derived: {m}"),
+        )
+    })?;
+    if f.is_empty() {
+        return Err(cx.err(
+            "faces_vertices",
+            "missing, and the edges enclose no face (give faces_vertices)",
+        ));
+    }
+    Ok(f)
+}
+
+/// One frame: its own fields `own` (field prefix `prefix`), after inheritance `res`, its
+/// coordinates; `key` (the key frame, resolved) for every frame but the key frame, whose
+/// mesh (`n` vertices, `ne` edges) it must share.
+fn parse_frame(
+    cx: &Ctx,
+    (prefix, own): &RawFrame,
+    res: &Map<String, Value>,
+    key: Option<&Map<String, Value>>,
+    (coords, coords_2d): (Vec<[f64; 3]>, bool),
+    n: usize,
+    ne: usize,
+) -> Result<FoldFrame, FoldError> {
+    if coords.len() != n {
+        return Err(cx.err(
+            format!("{prefix}vertices_coords"),
+            format!("{} vertices, but the key frame has {n}; foldsynth compares frames vertex by vertex", coords.len()),
+        ));
+    }
+    if let Some(key) = key {
+        for (key_name, mine) in [("edges_vertices", "edges"), ("faces_vertices", "faces")] {
+            if let Some(v) = own.get(key_name)
+                && Some(v) != key.get(key_name)
+            {
+                return Err(cx.err(
+                    format!("{prefix}{key_name}"),
+                    format!("this frame has its own {mine}, different from the key frame's; every frame must share the key frame's mesh"),
+                ));
+            }
+        }
+    }
+    let classes = match res.get("frame_classes") {
+        Some(v) => cx.strings(v, &format!("{prefix}frame_classes"))?,
+        None => Vec::new(),
+    };
+    let angles = parse_fold_angles(cx, res, prefix, ne)?;
+    let fold_angles_own = angles.as_ref().is_some_and(|(_, k)| own.contains_key(*k));
+    let fold_angles = angles.map(|(a, _)| a);
+    let t = match res.get("foldsynth:t") {
+        None => None,
+        Some(v) => Some(cx.number(v, &format!("{prefix}foldsynth:t"))?),
+    };
+    Ok(FoldFrame {
+        classes,
+        coords,
+        coords_2d,
+        fold_angles,
+        fold_angles_own,
+        t,
+    })
+}
+
+/// Fold angles in degrees per edge, `None` where the file has `null`.
+type FoldAngles = Vec<Option<f64>>;
+
+/// A frame's fold angles (`res`, after inheritance, `ne` edges), if it has any, with the
+/// key they are under: `edges_foldAngle`, or the pre-1.1 `edges_foldAngles`.
+fn parse_fold_angles(
+    cx: &Ctx,
+    res: &Map<String, Value>,
+    prefix: &str,
+    ne: usize,
+) -> Result<Option<(FoldAngles, &'static str)>, FoldError> {
+    let angle_key = if res.contains_key("edges_foldAngle") {
+        Some("edges_foldAngle")
+    } else if res.contains_key("edges_foldAngles") {
+        Some("edges_foldAngles")
+    } else {
+        None
+    };
+    let Some(k) = angle_key else {
+        return Ok(None);
+    };
+    let field = format!("{prefix}{k}");
+    let a = cx.array(&res[k], &field)?;
+    if a.len() != ne {
+        return Err(cx.err(
+            field,
+            format!("{} entries, expected one per edge ({ne})", a.len()),
+        ));
+    }
+    let mut out = Vec::with_capacity(ne);
+    for (i, x) in a.iter().enumerate() {
+        out.push(if x.is_null() {
+            None
+        } else {
+            let d = cx.number(x, &format!("{field}[{i}]"))?;
+            if d.abs() > 180.0 {
+                return Err(cx.err(
+                    format!("{field}[{i}]"),
+                    format!("{d} is outside [-180, 180] degrees"),
+                ));
+            }
+            Some(d)
+        });
+    }
+    Ok(Some((out, k)))
+}
+
+fn resolve_inheritance(cx: &Ctx, raw: &[RawFrame]) -> Result<Vec<Map<String, Value>>, FoldError> {
     let n = raw.len();
     let mut out: Vec<Option<Map<String, Value>>> = vec![None; n];
     out[0] = Some(raw[0].1.clone());
     fn go(
         cx: &Ctx,
-        raw: &[(String, Map<String, Value>)],
+        raw: &[RawFrame],
         out: &mut Vec<Option<Map<String, Value>>>,
         i: usize,
         depth: usize,

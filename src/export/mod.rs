@@ -28,6 +28,7 @@
 pub mod fold;
 pub mod lzw;
 pub mod mesh;
+pub mod palette;
 pub mod plots;
 pub mod raster;
 pub mod render;

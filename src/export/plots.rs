@@ -76,6 +76,39 @@ pub struct TreeNode {
 /// The search tree as SVG: one row per number of rule applications, edges parent → child,
 /// node colour by status, the rule sequence below each node (and as a hover title).
 pub fn search_tree_svg(nodes: &[TreeNode]) -> Result<String> {
+    check_tree(nodes)?;
+    let t = TreeLayout::new(nodes);
+    let mut s = t.header(nodes);
+    for n in nodes {
+        if let Some(p) = n.parent {
+            let _ = writeln!(
+                s,
+                "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#9a9a9a\" stroke-width=\"0.8\"/>",
+                t.xpos[&p],
+                t.ypos[&p] + 5.0,
+                t.xpos[&n.id],
+                t.ypos[&n.id] - 5.0
+            );
+        }
+    }
+    for n in nodes {
+        let (x, y) = (t.xpos[&n.id], t.ypos[&n.id]);
+        let (fill, stroke, dash) = n.status.style();
+        let label = xml_escape(&n.label);
+        let _ = writeln!(
+            s,
+            "<g><title>{label} ({})</title><circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"5\" fill=\"{fill}\" stroke=\"{stroke}\"{dash}/><text x=\"{x:.1}\" y=\"{:.1}\" font-size=\"9\" transform=\"rotate(90 {x:.1} {:.1})\" dominant-baseline=\"middle\">{label}</text></g>",
+            n.status.name(),
+            y + 9.0,
+            y + 9.0
+        );
+    }
+    s.push_str("</svg>");
+    Ok(s)
+}
+
+/// Ids are unique, parents exist, and a child is one level below its parent.
+fn check_tree(nodes: &[TreeNode]) -> Result<()> {
     if nodes.is_empty() {
         return Err(ExportError::invalid("tree", "no nodes"));
     }
@@ -104,100 +137,116 @@ pub fn search_tree_svg(nodes: &[TreeNode]) -> Result<String> {
             }
         }
     }
-    let mut levels: BTreeMap<usize, Vec<&TreeNode>> = BTreeMap::new();
-    for n in nodes {
-        levels.entry(n.level).or_default().push(n);
-    }
-    let widest = levels.values().map(Vec::len).max().unwrap_or(1);
-    let longest = nodes
-        .iter()
-        .map(|n| n.label.chars().count())
-        .max()
-        .unwrap_or(0);
-    let (left, top, right) = (70.0, 70.0, 20.0);
-    let spacing = 18.0;
-    let width = (widest as f64 * spacing + left + right).max(900.0);
-    let row = 34.0 + 5.6 * longest as f64;
-    let first = *levels.keys().next().unwrap_or(&0);
-    let height = top + row * levels.len() as f64 + 10.0;
+    Ok(())
+}
 
-    // Place rows top-down; children ordered by their parent's x, then by id.
-    let mut xpos: HashMap<usize, f64> = HashMap::new();
-    let mut ypos: HashMap<usize, f64> = HashMap::new();
-    for (&lvl, row_nodes) in &levels {
-        let mut sorted = row_nodes.clone();
-        sorted.sort_by(|a, b| {
-            let pa = a.parent.and_then(|p| xpos.get(&p)).copied().unwrap_or(-1.0);
-            let pb = b.parent.and_then(|p| xpos.get(&p)).copied().unwrap_or(-1.0);
-            pa.total_cmp(&pb).then(a.id.cmp(&b.id))
-        });
-        let usable = width - left - right;
-        let step = usable / sorted.len() as f64;
-        for (k, n) in sorted.iter().enumerate() {
-            xpos.insert(n.id, left + step * (k as f64 + 0.5));
-            ypos.insert(n.id, top + row * (lvl - first) as f64);
+/// Where the search tree's rows and nodes go.
+struct TreeLayout<'a> {
+    /// The nodes of each level.
+    levels: BTreeMap<usize, Vec<&'a TreeNode>>,
+    /// The first level (the top row).
+    first: usize,
+    width: f64,
+    height: f64,
+    /// Margins.
+    left: f64,
+    top: f64,
+    right: f64,
+    /// Height of a row (room for the longest label, written downward).
+    row: f64,
+    /// Position of each node by id.
+    xpos: HashMap<usize, f64>,
+    ypos: HashMap<usize, f64>,
+}
+
+impl<'a> TreeLayout<'a> {
+    fn new(nodes: &'a [TreeNode]) -> TreeLayout<'a> {
+        let mut levels: BTreeMap<usize, Vec<&TreeNode>> = BTreeMap::new();
+        for n in nodes {
+            levels.entry(n.level).or_default().push(n);
+        }
+        let widest = levels.values().map(Vec::len).max().unwrap_or(1);
+        let longest = nodes
+            .iter()
+            .map(|n| n.label.chars().count())
+            .max()
+            .unwrap_or(0);
+        let (left, top, right) = (70.0, 70.0, 20.0);
+        let spacing = 18.0;
+        let width = (widest as f64 * spacing + left + right).max(900.0);
+        let row = 34.0 + 5.6 * longest as f64;
+        let first = *levels.keys().next().unwrap_or(&0);
+        let height = top + row * levels.len() as f64 + 10.0;
+
+        // Place rows top-down; children ordered by their parent's x, then by id.
+        let mut xpos: HashMap<usize, f64> = HashMap::new();
+        let mut ypos: HashMap<usize, f64> = HashMap::new();
+        for (&lvl, row_nodes) in &levels {
+            let mut sorted = row_nodes.clone();
+            sorted.sort_by(|a, b| {
+                let pa = a.parent.and_then(|p| xpos.get(&p)).copied().unwrap_or(-1.0);
+                let pb = b.parent.and_then(|p| xpos.get(&p)).copied().unwrap_or(-1.0);
+                pa.total_cmp(&pb).then(a.id.cmp(&b.id))
+            });
+            let usable = width - left - right;
+            let step = usable / sorted.len() as f64;
+            for (k, n) in sorted.iter().enumerate() {
+                xpos.insert(n.id, left + step * (k as f64 + 0.5));
+                ypos.insert(n.id, top + row * (lvl - first) as f64);
+            }
+        }
+        TreeLayout {
+            levels,
+            first,
+            width,
+            height,
+            left,
+            top,
+            right,
+            row,
+            xpos,
+            ypos,
         }
     }
 
-    let mut counts: BTreeMap<NodeStatus, usize> = BTreeMap::new();
-    for n in nodes {
-        *counts.entry(n.status).or_default() += 1;
-    }
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width:.0}\" height=\"{height:.0}\" viewBox=\"0 0 {width:.0} {height:.0}\" font-family=\"sans-serif\">\n<rect width=\"{width:.0}\" height=\"{height:.0}\" fill=\"#ffffff\"/>\n"
-    );
-    let _ = writeln!(
-        s,
-        "<text x=\"{left}\" y=\"22\" font-size=\"15\" font-weight=\"bold\">Search tree: {} graphs (rows: number of rule applications)</text>",
-        nodes.len()
-    );
-    let mut lx = left;
-    for (st, c) in &counts {
-        let (fill, stroke, dash) = st.style();
+    /// The picture up to its edges and nodes: title, legend with counts, row lines.
+    fn header(&self, nodes: &[TreeNode]) -> String {
+        let (width, height, left) = (self.width, self.height, self.left);
+        let mut counts: BTreeMap<NodeStatus, usize> = BTreeMap::new();
+        for n in nodes {
+            *counts.entry(n.status).or_default() += 1;
+        }
+        let mut s = format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width:.0}\" height=\"{height:.0}\" viewBox=\"0 0 {width:.0} {height:.0}\" font-family=\"sans-serif\">\n<rect width=\"{width:.0}\" height=\"{height:.0}\" fill=\"#ffffff\"/>\n"
+        );
         let _ = writeln!(
             s,
-            "<circle cx=\"{:.1}\" cy=\"42\" r=\"6\" fill=\"{fill}\" stroke=\"{stroke}\"{dash}/><text x=\"{:.1}\" y=\"46\" font-size=\"12\">{} ({c})</text>",
-            lx + 6.0,
-            lx + 16.0,
-            st.name()
+            "<text x=\"{left}\" y=\"22\" font-size=\"15\" font-weight=\"bold\">Search tree: {} graphs (rows: number of rule applications)</text>",
+            nodes.len()
         );
-        lx += 130.0;
-    }
-    for &lvl in levels.keys() {
-        let y = top + row * (lvl - first) as f64;
-        let _ = writeln!(
-            s,
-            "<text x=\"10\" y=\"{:.1}\" font-size=\"12\" fill=\"#555555\">{lvl}</text><line x1=\"28\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"#eeeeee\"/>",
-            y + 4.0,
-            width - right
-        );
-    }
-    for n in nodes {
-        if let Some(p) = n.parent {
+        let mut lx = left;
+        for (st, c) in &counts {
+            let (fill, stroke, dash) = st.style();
             let _ = writeln!(
                 s,
-                "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#9a9a9a\" stroke-width=\"0.8\"/>",
-                xpos[&p],
-                ypos[&p] + 5.0,
-                xpos[&n.id],
-                ypos[&n.id] - 5.0
+                "<circle cx=\"{:.1}\" cy=\"42\" r=\"6\" fill=\"{fill}\" stroke=\"{stroke}\"{dash}/><text x=\"{:.1}\" y=\"46\" font-size=\"12\">{} ({c})</text>",
+                lx + 6.0,
+                lx + 16.0,
+                st.name()
+            );
+            lx += 130.0;
+        }
+        for &lvl in self.levels.keys() {
+            let y = self.top + self.row * (lvl - self.first) as f64;
+            let _ = writeln!(
+                s,
+                "<text x=\"10\" y=\"{:.1}\" font-size=\"12\" fill=\"#555555\">{lvl}</text><line x1=\"28\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"#eeeeee\"/>",
+                y + 4.0,
+                width - self.right
             );
         }
+        s
     }
-    for n in nodes {
-        let (x, y) = (xpos[&n.id], ypos[&n.id]);
-        let (fill, stroke, dash) = n.status.style();
-        let label = xml_escape(&n.label);
-        let _ = writeln!(
-            s,
-            "<g><title>{label} ({})</title><circle cx=\"{x:.1}\" cy=\"{y:.1}\" r=\"5\" fill=\"{fill}\" stroke=\"{stroke}\"{dash}/><text x=\"{x:.1}\" y=\"{:.1}\" font-size=\"9\" transform=\"rotate(90 {x:.1} {:.1})\" dominant-baseline=\"middle\">{label}</text></g>",
-            n.status.name(),
-            y + 9.0,
-            y + 9.0
-        );
-    }
-    s.push_str("</svg>");
-    Ok(s)
 }
 
 /// One line of the distribution plot.
@@ -249,6 +298,27 @@ const PALETTE: [&str; 6] = [
 /// The distribution plot as SVG: axes with ticks, one polyline with markers per series,
 /// and a legend.
 pub fn distribution_svg(plot: &DistributionPlot) -> Result<String> {
+    check_distribution(plot)?;
+    let ax = Axes::fit(plot);
+    let (w, h, ml) = (ax.w, ax.h, ax.ml);
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\" font-family=\"sans-serif\">\n<rect width=\"{w}\" height=\"{h}\" fill=\"#ffffff\"/>\n"
+    );
+    let _ = writeln!(
+        s,
+        "<text x=\"{ml}\" y=\"22\" font-size=\"15\" font-weight=\"bold\">{}</text>",
+        xml_escape(&plot.title)
+    );
+    ax.draw(&mut s, plot);
+    for (i, se) in plot.series.iter().enumerate() {
+        ax.draw_series(&mut s, i, se);
+    }
+    s.push_str("</svg>");
+    Ok(s)
+}
+
+/// Some point to plot, and every number finite.
+fn check_distribution(plot: &DistributionPlot) -> Result<()> {
     if plot.series.is_empty() || plot.series.iter().all(|s| s.points.is_empty()) {
         return Err(ExportError::invalid(
             "distribution.series",
@@ -265,107 +335,153 @@ pub fn distribution_svg(plot: &DistributionPlot) -> Result<String> {
             }
         }
     }
-    let all = plot.series.iter().flat_map(|s| s.points.iter());
-    let (mut x0, mut x1, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
-    let mut y0 = 0.0f64;
-    for p in all {
-        x0 = x0.min(p[0]);
-        x1 = x1.max(p[0]);
-        y0 = y0.min(p[1]);
-        y1 = y1.max(p[1]);
-    }
-    if x1 == x0 {
-        x0 -= 1.0;
-        x1 += 1.0;
-    }
-    if y1 == y0 {
-        y1 = y0 + 1.0;
-    }
-    let ystep = tick_step(y1 - y0, 5.0);
-    let y1 = (y1 / ystep).ceil() * ystep;
-    let y0 = (y0 / ystep).floor() * ystep;
-    let xstep = tick_step(x1 - x0, 8.0).max(
-        if plot
-            .series
-            .iter()
-            .all(|s| s.points.iter().all(|p| p[0].fract() == 0.0))
-        {
-            1.0
-        } else {
-            0.0
-        },
-    );
-    let (w, h) = (640.0, 400.0);
-    let (ml, mr, mt, mb) = (70.0, 170.0, 40.0, 50.0);
-    let px = |x: f64| ml + (x - x0) / (x1 - x0) * (w - ml - mr);
-    let py = |y: f64| h - mb - (y - y0) / (y1 - y0) * (h - mt - mb);
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\" font-family=\"sans-serif\">\n<rect width=\"{w}\" height=\"{h}\" fill=\"#ffffff\"/>\n"
-    );
-    let _ = writeln!(
-        s,
-        "<text x=\"{ml}\" y=\"22\" font-size=\"15\" font-weight=\"bold\">{}</text>",
-        xml_escape(&plot.title)
-    );
-    // Grid and ticks.
-    let mut y = y0;
-    while y <= y1 + 1e-9 * ystep {
-        let _ = writeln!(
-            s,
-            "<line x1=\"{ml}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#e6e6e6\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"end\">{}</text>",
-            py(y),
-            w - mr,
-            py(y),
-            ml - 6.0,
-            py(y) + 4.0,
-            fmt_tick(y, ystep)
+    Ok(())
+}
+
+/// The distribution plot's axes: ranges, tick steps, the picture's size and margins.
+struct Axes {
+    x0: f64,
+    x1: f64,
+    y0: f64,
+    y1: f64,
+    xstep: f64,
+    ystep: f64,
+    w: f64,
+    h: f64,
+    /// Margins: left, right (room for the legend), top, bottom.
+    ml: f64,
+    mr: f64,
+    mt: f64,
+    mb: f64,
+}
+
+impl Axes {
+    /// Axes holding every point, the y-axis from 0 (or below), ranges rounded to ticks.
+    fn fit(plot: &DistributionPlot) -> Axes {
+        let all = plot.series.iter().flat_map(|s| s.points.iter());
+        let (mut x0, mut x1, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
+        let mut y0 = 0.0f64;
+        for p in all {
+            x0 = x0.min(p[0]);
+            x1 = x1.max(p[0]);
+            y0 = y0.min(p[1]);
+            y1 = y1.max(p[1]);
+        }
+        if x1 == x0 {
+            x0 -= 1.0;
+            x1 += 1.0;
+        }
+        if y1 == y0 {
+            y1 = y0 + 1.0;
+        }
+        let ystep = tick_step(y1 - y0, 5.0);
+        let y1 = (y1 / ystep).ceil() * ystep;
+        let y0 = (y0 / ystep).floor() * ystep;
+        let xstep = tick_step(x1 - x0, 8.0).max(
+            if plot
+                .series
+                .iter()
+                .all(|s| s.points.iter().all(|p| p[0].fract() == 0.0))
+            {
+                1.0
+            } else {
+                0.0
+            },
         );
-        y += ystep;
+        let (w, h) = (640.0, 400.0);
+        let (ml, mr, mt, mb) = (70.0, 170.0, 40.0, 50.0);
+        Axes {
+            x0,
+            x1,
+            y0,
+            y1,
+            xstep,
+            ystep,
+            w,
+            h,
+            ml,
+            mr,
+            mt,
+            mb,
+        }
     }
-    let mut x = (x0 / xstep).ceil() * xstep;
-    while x <= x1 + 1e-9 * xstep {
+
+    /// The pixel column of `x`.
+    fn px(&self, x: f64) -> f64 {
+        self.ml + (x - self.x0) / (self.x1 - self.x0) * (self.w - self.ml - self.mr)
+    }
+
+    /// The pixel row of `y`.
+    fn py(&self, y: f64) -> f64 {
+        self.h - self.mb - (y - self.y0) / (self.y1 - self.y0) * (self.h - self.mt - self.mb)
+    }
+
+    /// Grid, ticks, the axes and their labels.
+    fn draw(&self, s: &mut String, plot: &DistributionPlot) {
+        let (w, h, ml, mr, mt, mb) = (self.w, self.h, self.ml, self.mr, self.mt, self.mb);
+        let (px, py) = (|x| self.px(x), |y| self.py(y));
+        let mut y = self.y0;
+        while y <= self.y1 + 1e-9 * self.ystep {
+            let _ = writeln!(
+                s,
+                "<line x1=\"{ml}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#e6e6e6\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"end\">{}</text>",
+                py(y),
+                w - mr,
+                py(y),
+                ml - 6.0,
+                py(y) + 4.0,
+                fmt_tick(y, self.ystep)
+            );
+            y += self.ystep;
+        }
+        let mut x = (self.x0 / self.xstep).ceil() * self.xstep;
+        while x <= self.x1 + 1e-9 * self.xstep {
+            let _ = writeln!(
+                s,
+                "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#444444\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"middle\">{}</text>",
+                px(x),
+                h - mb,
+                px(x),
+                h - mb + 5.0,
+                px(x),
+                h - mb + 18.0,
+                fmt_tick(x, self.xstep)
+            );
+            x += self.xstep;
+        }
         let _ = writeln!(
             s,
-            "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#444444\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"middle\">{}</text>",
-            px(x),
+            "<line x1=\"{ml}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#444444\"/><line x1=\"{ml}\" y1=\"{mt}\" x2=\"{ml}\" y2=\"{:.1}\" stroke=\"#444444\"/>",
             h - mb,
-            px(x),
-            h - mb + 5.0,
-            px(x),
-            h - mb + 18.0,
-            fmt_tick(x, xstep)
+            w - mr,
+            h - mb,
+            h - mb
         );
-        x += xstep;
+        let _ = writeln!(
+            s,
+            "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"middle\">{}</text>",
+            0.5 * (ml + w - mr),
+            h - 12.0,
+            xml_escape(&plot.x_label)
+        );
+        let _ = writeln!(
+            s,
+            "<text x=\"16\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"middle\" transform=\"rotate(-90 16 {:.1})\">{}</text>",
+            0.5 * (mt + h - mb),
+            0.5 * (mt + h - mb),
+            xml_escape(&plot.y_label)
+        );
     }
-    let _ = writeln!(
-        s,
-        "<line x1=\"{ml}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"#444444\"/><line x1=\"{ml}\" y1=\"{mt}\" x2=\"{ml}\" y2=\"{:.1}\" stroke=\"#444444\"/>",
-        h - mb,
-        w - mr,
-        h - mb,
-        h - mb
-    );
-    let _ = writeln!(
-        s,
-        "<text x=\"{:.1}\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"middle\">{}</text>",
-        0.5 * (ml + w - mr),
-        h - 12.0,
-        xml_escape(&plot.x_label)
-    );
-    let _ = writeln!(
-        s,
-        "<text x=\"16\" y=\"{:.1}\" font-size=\"12\" text-anchor=\"middle\" transform=\"rotate(-90 16 {:.1})\">{}</text>",
-        0.5 * (mt + h - mb),
-        0.5 * (mt + h - mb),
-        xml_escape(&plot.y_label)
-    );
-    for (i, se) in plot.series.iter().enumerate() {
+
+    /// Series `i`: its polyline with markers, and its line of the legend.
+    fn draw_series(&self, s: &mut String, i: usize, se: &Series) {
+        let (w, mr, mt) = (self.w, self.mr, self.mt);
         let c = PALETTE[i % PALETTE.len()];
         let mut pts = se.points.clone();
         pts.sort_by(|a, b| a[0].total_cmp(&b[0]));
         let attr: Vec<String> = pts
             .iter()
-            .map(|p| format!("{:.1},{:.1}", px(p[0]), py(p[1])))
+            .map(|p| format!("{:.1},{:.1}", self.px(p[0]), self.py(p[1])))
             .collect();
         let _ = writeln!(
             s,
@@ -377,8 +493,8 @@ pub fn distribution_svg(plot: &DistributionPlot) -> Result<String> {
             let _ = writeln!(
                 s,
                 "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"3\" fill=\"{c}\"/>",
-                px(p[0]),
-                py(p[1])
+                self.px(p[0]),
+                self.py(p[1])
             );
         }
         s.push_str("</g>\n");
@@ -393,8 +509,6 @@ pub fn distribution_svg(plot: &DistributionPlot) -> Result<String> {
             xml_escape(&se.name)
         );
     }
-    s.push_str("</svg>");
-    Ok(s)
 }
 
 #[cfg(test)]

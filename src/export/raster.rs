@@ -11,7 +11,7 @@
 
 use std::collections::HashMap;
 
-use super::render::GifPalette;
+use super::palette::GifPalette;
 
 /// A colour to paint with: straight RGB and an alpha.
 pub type Rgba = [u8; 4];
@@ -365,7 +365,7 @@ fn centre_index(v: f64, n: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::export::render::gif_palette;
+    use crate::export::palette::gif_palette;
 
     const WHITE: Rgba = [255, 255, 255, 255];
     const INK: Rgba = [50, 50, 50, 255];

@@ -249,73 +249,175 @@ fn magnitude(coords: &[[f64; 3]]) -> f64 {
 
 /// Verify a FOLD file read by [`FoldFile`]; see the module docs for the checks.
 pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
-    let key = &f.frames[0].coords;
-    let n = key.len();
-    let angle_tol_rad = opts.angle_tol_deg.to_radians();
-    let mut checks = Vec::new();
     let frames_coords: Vec<&[[f64; 3]]> = f.frames.iter().map(|fr| fr.coords.as_slice()).collect();
     let prec = precision(&frames_coords, opts.digits);
-    // Absolute rounding error of a coordinate, per frame.
-    let delta: Vec<f64> = f
-        .frames
-        .iter()
-        .map(|fr| prec.relative * magnitude(&fr.coords))
-        .collect();
-    let d0 = delta[0];
+    let sheet = Sheet::new(f, opts, &prec);
+    let mut checks = Vec::new();
+    let kf = classify(&sheet);
+    check_key_frame(&sheet, &kf, &mut checks);
+    check_planar_faces(&sheet, &mut checks);
+    let adj = EdgeFaces::new(&f.edges, &f.faces);
+    check_face_sides(&adj, &mut checks);
+    let topo_boundary = check_manifold(&sheet, &adj, &mut checks);
+    let bverts = check_euler(&sheet, &topo_boundary, &mut checks);
+    check_developability(&sheet, &bverts, &mut checks);
+    check_key_fold_angles(&sheet, &adj, kf.key_frame, &mut checks);
+    let frames = check_frames(&sheet, &adj);
+    if frames.is_empty() {
+        not_checked_push(
+            &mut checks,
+            "folded frames",
+            "the file has no frames after frame 0: no motion to check".into(),
+        );
+    }
 
-    // Scale of the whole sheet, for relative tolerances.
-    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-    for p in key {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
+    let ok = checks.iter().all(|c| c.ok) && frames.iter().all(|fr| fr.ok);
+    let Classified {
+        plane,
+        planar,
+        reference,
+        key_frame,
+        ..
+    } = kf;
+    VerifyReport {
+        file: f.source.clone(),
+        ok,
+        vertices: sheet.key.len(),
+        edges: f.edges.len(),
+        faces: f.faces.len(),
+        faces_derived: f.faces_derived,
+        edges_derived: f.edges_derived,
+        assignment_derived: f.assignment_derived,
+        key_frame,
+        plane: plane.filter(|_| planar).map(|(c, _)| {
+            [
+                c,
+                reference.unwrap_or_else(|| plane.map_or([0.0, 0.0, 1.0], |p| p.1)),
+            ]
+        }),
+        tol: opts.tol,
+        angle_tol_deg: opts.angle_tol_deg,
+        precision: prec,
+        checks,
+        frames,
+    }
+}
+
+/// What the checks of one file share: the file, the tolerances, frame 0 with its scale and
+/// faces, and the rounding error the coordinates allow.
+struct Sheet<'a> {
+    f: &'a FoldFile,
+    opts: &'a VerifyOptions,
+    /// Frame 0's coordinates.
+    key: &'a [[f64; 3]],
+    /// Absolute rounding error of a coordinate, per frame.
+    delta: Vec<f64>,
+    /// Frame 0's, `delta[0]`.
+    d0: f64,
+    /// Scale of the whole sheet (its bounding box's diagonal), for relative tolerances.
+    size: f64,
+    /// Newell normal of each face in frame 0 (its length is twice the face's area).
+    normals: Vec<[f64; 3]>,
+    /// Longest chord of each face in frame 0.
+    face_size: Vec<f64>,
+    /// A face's height over its longest chord (twice its area over its size): how far a
+    /// rounding error of a coordinate can tilt it.
+    face_height: Vec<f64>,
+}
+
+impl<'a> Sheet<'a> {
+    fn new(f: &'a FoldFile, opts: &'a VerifyOptions, prec: &Precision) -> Sheet<'a> {
+        let key = &f.frames[0].coords;
+        let delta: Vec<f64> = f
+            .frames
+            .iter()
+            .map(|fr| prec.relative * magnitude(&fr.coords))
+            .collect();
+        let d0 = delta[0];
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for p in key {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        let size = geom::dist(lo, hi).max(f64::MIN_POSITIVE);
+        let normals: Vec<[f64; 3]> = (0..f.faces.len())
+            .map(|fi| geom::newell_normal(&face_pts(f, key, fi)))
+            .collect();
+        let face_size: Vec<f64> = f
+            .faces
+            .iter()
+            .map(|fc| {
+                let mut s: f64 = 0.0;
+                for i in 0..fc.len() {
+                    for j in i + 1..fc.len() {
+                        s = s.max(geom::dist(key[fc[i]], key[fc[j]]));
+                    }
+                }
+                s
+            })
+            .collect();
+        let face_height: Vec<f64> = (0..f.faces.len())
+            .map(|fi| geom::norm(normals[fi]) / face_size[fi].max(f64::MIN_POSITIVE))
+            .collect();
+        Sheet {
+            f,
+            opts,
+            key,
+            delta,
+            d0,
+            size,
+            normals,
+            face_size,
+            face_height,
         }
     }
-    let size = geom::dist(lo, hi).max(f64::MIN_POSITIVE);
+}
 
-    let face_pts = |coords: &[[f64; 3]], fi: usize| -> Vec<[f64; 3]> {
-        f.faces[fi].iter().map(|&v| coords[v]).collect()
-    };
-    let normals: Vec<[f64; 3]> = (0..f.faces.len())
-        .map(|fi| geom::newell_normal(&face_pts(key, fi)))
-        .collect();
-    let face_size: Vec<f64> = f
-        .faces
-        .iter()
-        .map(|fc| {
-            let mut s: f64 = 0.0;
-            for i in 0..fc.len() {
-                for j in i + 1..fc.len() {
-                    s = s.max(geom::dist(key[fc[i]], key[fc[j]]));
-                }
-            }
-            s
-        })
-        .collect();
-    // A face's height over its longest chord (twice its area over its size): how far a
-    // rounding error of a coordinate can tilt it.
-    let face_height: Vec<f64> = (0..f.faces.len())
-        .map(|fi| geom::norm(normals[fi]) / face_size[fi].max(f64::MIN_POSITIVE))
-        .collect();
+/// The corners of face `fi` at `coords`.
+fn face_pts(f: &FoldFile, coords: &[[f64; 3]], fi: usize) -> Vec<[f64; 3]> {
+    f.faces[fi].iter().map(|&v| coords[v]).collect()
+}
 
-    // The plane of frame 0 and what frame 0 is.
+/// The plane of frame 0 and what frame 0 is.
+struct Classified {
+    /// The best plane through frame 0 (point, unit normal).
+    plane: Option<([f64; 3], [f64; 3])>,
+    /// The largest distance of a vertex from it.
+    flatness: f64,
+    /// The largest distance allowed for a flat frame 0.
+    flat_allowed: f64,
+    planar: bool,
+    /// The normal the faces should turn about: +z for a plane z = const (the spec's
+    /// counter-clockwise), else the one the faces turn to.
+    reference: Option<[f64; 3]>,
+    /// Faces turned about `reference` counter-clockwise.
+    forward: Vec<usize>,
+    /// The others (degenerate faces count as turned the wrong way).
+    backward: Vec<usize>,
+    key_frame: KeyFrame,
+}
+
+/// Fit frame 0's plane and decide what frame 0 is (see the module docs).
+fn classify(s: &Sheet) -> Classified {
+    let f = s.f;
     let declared = |c: &str| f.frames[0].classes.iter().any(|x| x == c);
     let declared_cp = declared("creasePattern");
-    let plane = geom::fit_plane(key);
+    let plane = geom::fit_plane(s.key);
     let flatness = plane.map_or(0.0, |(c, nrm)| {
-        key.iter()
+        s.key
+            .iter()
             .map(|p| geom::dot(geom::sub(*p, c), nrm).abs())
             .fold(0.0, f64::max)
     });
-    let flat_allowed = opts.tol * size + 4.0 * d0;
+    let flat_allowed = s.opts.tol * s.size + 4.0 * s.d0;
     let planar = plane.is_some() && flatness <= flat_allowed;
-    // The reference normal: +z for a plane z = const (the spec's counter-clockwise),
-    // else the one the faces turn to.
     let reference = plane.map(|(_, nrm)| {
         if nrm[0].abs() <= 1e-9 && nrm[1].abs() <= 1e-9 {
             [0.0, 0.0, 1.0]
         } else {
-            let total = normals.iter().fold([0.0; 3], |a, &b| geom::add(a, b));
+            let total = s.normals.iter().fold([0.0; 3], |a, &b| geom::add(a, b));
             if geom::dot(total, nrm) < 0.0 {
                 geom::scale(nrm, -1.0)
             } else {
@@ -323,21 +425,7 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             }
         }
     });
-    // Faces by the way they turn about the reference normal (degenerate: neither).
-    let (mut forward, mut backward) = (Vec::new(), Vec::new());
-    if let Some(r) = reference {
-        for fi in 0..f.faces.len() {
-            let a = geom::dot(normals[fi], r);
-            // Twice the area; rounding can move it by about δ per unit of perimeter.
-            let slack = 1e-12 * face_size[fi] * face_size[fi] + 8.0 * d0 * face_size[fi];
-            // Degenerate faces count as turned the wrong way.
-            if a > slack {
-                forward.push(fi);
-            } else {
-                backward.push(fi);
-            }
-        }
-    }
+    let (forward, backward) = turning(s, reference);
     let mixed = !forward.is_empty() && !backward.is_empty();
     let key_frame = if !planar {
         if declared_cp {
@@ -358,99 +446,137 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             KeyFrame::CreasePattern
         }
     };
-    let plane_text = |c: [f64; 3], nrm: [f64; 3]| {
-        let axis = [(0, "x"), (1, "y"), (2, "z")]
-            .into_iter()
-            .find(|&(k, _)| nrm[k].abs() >= 1.0 - 1e-9);
-        match axis {
-            Some((k, name)) => format!("the plane {name} = {:.4}", tidy(c[k])),
-            None => format!(
-                "the plane through ({:.4}, {:.4}, {:.4}) with normal ({:.4}, {:.4}, {:.4})",
-                tidy(c[0]),
-                tidy(c[1]),
-                tidy(c[2]),
-                tidy(nrm[0]),
-                tidy(nrm[1]),
-                tidy(nrm[2])
-            ),
-        }
-    };
-    match key_frame {
-        KeyFrame::CreasePattern => {
-            let ok = planar;
-            let detail = match (plane, reference) {
-                (Some((c, _)), Some(nrm)) if ok => format!(
-                    "frame 0 lies in {} (max distance {flatness:.2e}, allowed {flat_allowed:.1e})",
-                    plane_text(c, nrm)
-                ),
-                _ => format!(
-                    "frame 0 is declared a crease pattern but is not flat: max distance from its best plane {flatness:.3e} (sheet size {size:.3}, allowed {flat_allowed:.1e})"
-                ),
-            };
-            push(&mut checks, "flat crease pattern", ok, detail);
-            if let (true, Some(r)) = (planar, reference) {
-                let bad: Vec<String> = backward.iter().map(|&fi| format!("face {fi}")).collect();
-                let about = if r == [0.0, 0.0, 1.0] {
-                    "counter-clockwise about +z".to_string()
-                } else {
-                    format!(
-                        "turned one way about the plane's normal ({:.4}, {:.4}, {:.4})",
-                        tidy(r[0]),
-                        tidy(r[1]),
-                        tidy(r[2])
-                    )
-                };
-                push(
-                    &mut checks,
-                    "faces oriented",
-                    bad.is_empty(),
-                    if bad.is_empty() {
-                        format!("all {} faces {about}", f.faces.len())
-                    } else {
-                        format!("not {about} (clockwise or degenerate): {}", list(&bad))
-                    },
-                );
+    Classified {
+        plane,
+        flatness,
+        flat_allowed,
+        planar,
+        reference,
+        forward,
+        backward,
+        key_frame,
+    }
+}
+
+/// Faces by the way they turn about the reference normal (degenerate: neither, counted
+/// backward): (forward, backward); both empty without a reference.
+fn turning(s: &Sheet, reference: Option<[f64; 3]>) -> (Vec<usize>, Vec<usize>) {
+    let (mut forward, mut backward) = (Vec::new(), Vec::new());
+    if let Some(r) = reference {
+        for fi in 0..s.f.faces.len() {
+            let a = geom::dot(s.normals[fi], r);
+            let size = s.face_size[fi];
+            // Twice the area; rounding can move it by about δ per unit of perimeter.
+            let slack = 1e-12 * size * size + 8.0 * s.d0 * size;
+            // Degenerate faces count as turned the wrong way.
+            if a > slack {
+                forward.push(fi);
+            } else {
+                backward.push(fi);
             }
         }
-        KeyFrame::FlatFolded => {
-            let why = format!(
-                "frame 0 is a flat-folded state ({} faces face one way, {} the other), not the crease pattern: the file has no flat sheet to check",
-                forward.len(),
-                backward.len()
-            );
-            not_checked_push(&mut checks, "flat crease pattern", why.clone());
-            not_checked_push(&mut checks, "faces oriented", why);
-        }
-        KeyFrame::FoldedForm => {
-            let why = format!(
-                "frame 0 is a folded form (not planar: {flatness:.2e} from its best plane; frame_classes {:?}): the file has no crease pattern, so flatness, face orientation and the isometry to the flat sheet cannot be checked",
-                f.frames[0].classes
-            );
-            not_checked_push(&mut checks, "flat crease pattern", why.clone());
-            not_checked_push(&mut checks, "faces oriented", why);
-        }
     }
+    (forward, backward)
+}
 
-    // Planar faces in frame 0: distance of every vertex from the face's plane.
+/// A plane in words: `the plane z = 0.5` when it is normal to an axis.
+fn plane_text(c: [f64; 3], nrm: [f64; 3]) -> String {
+    let axis = [(0, "x"), (1, "y"), (2, "z")]
+        .into_iter()
+        .find(|&(k, _)| nrm[k].abs() >= 1.0 - 1e-9);
+    match axis {
+        Some((k, name)) => format!("the plane {name} = {:.4}", tidy(c[k])),
+        None => format!(
+            "the plane through ({:.4}, {:.4}, {:.4}) with normal ({:.4}, {:.4}, {:.4})",
+            tidy(c[0]),
+            tidy(c[1]),
+            tidy(c[2]),
+            tidy(nrm[0]),
+            tidy(nrm[1]),
+            tidy(nrm[2])
+        ),
+    }
+}
+
+/// "flat crease pattern" and "faces oriented": checked for a crease pattern, said why not
+/// for the others.
+fn check_key_frame(s: &Sheet, kf: &Classified, checks: &mut Vec<Check>) {
+    let why = match kf.key_frame {
+        KeyFrame::CreasePattern => return check_crease_pattern(s, kf, checks),
+        KeyFrame::FlatFolded => format!(
+            "frame 0 is a flat-folded state ({} faces face one way, {} the other), not the crease pattern: the file has no flat sheet to check",
+            kf.forward.len(),
+            kf.backward.len()
+        ),
+        KeyFrame::FoldedForm => format!(
+            "frame 0 is a folded form (not planar: {:.2e} from its best plane; frame_classes {:?}): the file has no crease pattern, so flatness, face orientation and the isometry to the flat sheet cannot be checked",
+            kf.flatness, s.f.frames[0].classes
+        ),
+    };
+    not_checked_push(checks, "flat crease pattern", why.clone());
+    not_checked_push(checks, "faces oriented", why);
+}
+
+/// Frame 0 of a crease pattern is flat, and its faces turn one way.
+fn check_crease_pattern(s: &Sheet, kf: &Classified, checks: &mut Vec<Check>) {
+    let (flatness, flat_allowed, size) = (kf.flatness, kf.flat_allowed, s.size);
+    let ok = kf.planar;
+    let detail = match (kf.plane, kf.reference) {
+        (Some((c, _)), Some(nrm)) if ok => format!(
+            "frame 0 lies in {} (max distance {flatness:.2e}, allowed {flat_allowed:.1e})",
+            plane_text(c, nrm)
+        ),
+        _ => format!(
+            "frame 0 is declared a crease pattern but is not flat: max distance from its best plane {flatness:.3e} (sheet size {size:.3}, allowed {flat_allowed:.1e})"
+        ),
+    };
+    push(checks, "flat crease pattern", ok, detail);
+    if let (true, Some(r)) = (kf.planar, kf.reference) {
+        let bad: Vec<String> = kf.backward.iter().map(|&fi| format!("face {fi}")).collect();
+        let about = if r == [0.0, 0.0, 1.0] {
+            "counter-clockwise about +z".to_string()
+        } else {
+            format!(
+                "turned one way about the plane's normal ({:.4}, {:.4}, {:.4})",
+                tidy(r[0]),
+                tidy(r[1]),
+                tidy(r[2])
+            )
+        };
+        push(
+            checks,
+            "faces oriented",
+            bad.is_empty(),
+            if bad.is_empty() {
+                format!("all {} faces {about}", s.f.faces.len())
+            } else {
+                format!("not {about} (clockwise or degenerate): {}", list(&bad))
+            },
+        );
+    }
+}
+
+/// Planar faces in frame 0: distance of every vertex from the face's plane.
+fn check_planar_faces(s: &Sheet, checks: &mut Vec<Check>) {
     let mut worst_planar = (0.0f64, None, 0.0);
-    for fi in 0..f.faces.len() {
-        let Some(nrm) = geom::normalize(normals[fi]) else {
+    for fi in 0..s.f.faces.len() {
+        let Some(nrm) = geom::normalize(s.normals[fi]) else {
             continue;
         };
-        let pts = face_pts(key, fi);
+        let pts = face_pts(s.f, s.key, fi);
         let c = pts.iter().fold([0.0; 3], |a, &p| geom::add(a, p));
         let c = geom::scale(c, 1.0 / pts.len() as f64);
-        let s = face_size[fi].max(f64::MIN_POSITIVE);
-        let allowed = opts.tol + 4.0 * d0 / s;
+        let size = s.face_size[fi].max(f64::MIN_POSITIVE);
+        let allowed = s.opts.tol + 4.0 * s.d0 / size;
         for p in &pts {
-            let d = geom::dot(geom::sub(*p, c), nrm).abs() / s;
+            let d = geom::dot(geom::sub(*p, c), nrm).abs() / size;
             if d - allowed > worst_planar.0 - worst_planar.2 || worst_planar.1.is_none() {
                 worst_planar = (d, Some(fi), allowed);
             }
         }
     }
     push(
-        &mut checks,
+        checks,
         "planar faces",
         worst_planar.0 <= worst_planar.2,
         match worst_planar.1 {
@@ -461,15 +587,17 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             None => "every face is planar".into(),
         },
     );
+}
 
-    let adj = EdgeFaces::new(&f.edges, &f.faces);
+/// Every side of every face is an edge of `edges_vertices`.
+fn check_face_sides(adj: &EdgeFaces, checks: &mut Vec<Check>) {
     let missing: Vec<String> = adj
         .missing
         .iter()
         .map(|(fi, u, v)| format!("side {u}–{v} of face {fi}"))
         .collect();
     push(
-        &mut checks,
+        checks,
         "face sides are edges",
         missing.is_empty(),
         if missing.is_empty() {
@@ -478,7 +606,12 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             format!("not in edges_vertices: {}", list(&missing))
         },
     );
+}
 
+/// A boundary edge in one face, any other in two, one on each side. Returns which edges
+/// are in exactly one face (the boundary as the faces have it).
+fn check_manifold(s: &Sheet, adj: &EdgeFaces, checks: &mut Vec<Check>) -> Vec<bool> {
+    let f = s.f;
     let mut bad_manifold = Vec::new();
     let (mut n_boundary, mut n_interior) = (0, 0);
     let mut topo_boundary = vec![false; f.edges.len()];
@@ -512,7 +645,7 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
         }
     }
     push(
-        &mut checks,
+        checks,
         "manifold",
         bad_manifold.is_empty(),
         if bad_manifold.is_empty() {
@@ -528,8 +661,32 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             list(&bad_manifold)
         },
     );
+    topo_boundary
+}
 
-    // Euler characteristic against the topology of a planar sheet.
+/// Connected components among the vertices `verts` of `0..n` joined by `edges`.
+fn components(n: usize, edges: impl Iterator<Item = [usize; 2]>, verts: &[bool]) -> usize {
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    for [a, b] in edges {
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        parent[ra] = rb;
+    }
+    (0..n)
+        .filter(|&v| verts[v] && find(&mut parent, v) == v)
+        .count()
+}
+
+/// Euler characteristic against the topology of a planar sheet. Returns which vertices
+/// are on the boundary (on an edge of `topo_boundary`).
+fn check_euler(s: &Sheet, topo_boundary: &[bool], checks: &mut Vec<Check>) -> Vec<bool> {
+    let (f, n) = (s.f, s.key.len());
     let mut used = vec![false; n];
     for e in &f.edges {
         used[e[0]] = true;
@@ -541,30 +698,12 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
         }
     }
     let nv = used.iter().filter(|&&u| u).count();
-    let components = |edges: &mut dyn Iterator<Item = [usize; 2]>, verts: &[bool]| -> usize {
-        let mut parent: Vec<usize> = (0..n).collect();
-        fn find(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
-        for [a, b] in edges {
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            parent[ra] = rb;
-        }
-        (0..n)
-            .filter(|&v| verts[v] && find(&mut parent, v) == v)
-            .count()
-    };
-    let mut all_edges = f.edges.iter().copied();
-    let c = components(&mut all_edges, &used);
+    let c = components(n, f.edges.iter().copied(), &used);
     let mut bverts = vec![false; n];
     let bedges: Vec<[usize; 2]> = f
         .edges
         .iter()
-        .zip(&topo_boundary)
+        .zip(topo_boundary)
         .filter(|(_, b)| **b)
         .map(|(e, _)| *e)
         .collect();
@@ -573,14 +712,13 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
         bverts[e[1]] = true;
     }
     let nbv = bverts.iter().filter(|&&b| b).count();
-    let mut bit = bedges.iter().copied();
-    let bc = components(&mut bit, &bverts);
+    let bc = components(n, bedges.iter().copied(), &bverts);
     // Cycle rank of the boundary graph = number of boundary loops.
     let loops = bedges.len() as i64 - nbv as i64 + bc as i64;
     let chi = nv as i64 - f.edges.len() as i64 + f.faces.len() as i64;
     let expected = 2 * c as i64 - loops;
     push(
-        &mut checks,
+        checks,
         "Euler characteristic",
         chi == expected,
         format!(
@@ -594,19 +732,24 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             }
         ),
     );
+    bverts
+}
 
-    // Developability at interior vertices (on no boundary edge): the corner angles of the
-    // faces around it sum to 2π, in the flat sheet and in any folded form.
+/// Developability at interior vertices (not in `bverts`): the corner angles of the faces
+/// around it sum to 2π, in the flat sheet and in any folded form.
+fn check_developability(s: &Sheet, bverts: &[bool], checks: &mut Vec<Check>) {
+    let (key, n, d0) = (s.key, s.key.len(), s.d0);
+    let angle_tol_rad = s.opts.angle_tol_deg.to_radians();
     let mut sums = vec![0.0f64; n];
     let mut slack = vec![0.0f64; n];
     let mut has_face = vec![false; n];
-    for (fi, fc) in f.faces.iter().enumerate() {
+    for (fi, fc) in s.f.faces.iter().enumerate() {
         let m = fc.len();
         for k in 0..m {
             let v = fc[k];
             let (prev, next) = (key[fc[(k + m - 1) % m]], key[fc[(k + 1) % m]]);
             has_face[v] = true;
-            sums[v] += geom::corner_angle(prev, key[v], next, normals[fi]);
+            sums[v] += geom::corner_angle(prev, key[v], next, s.normals[fi]);
             // Rounding moves each side's direction by up to about 2δ/length.
             let inv = |p| 1.0 / geom::dist(p, key[v]).max(f64::MIN_POSITIVE);
             slack[v] += 4.0 * d0 * (inv(prev) + inv(next));
@@ -622,7 +765,7 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
         }
     }
     push(
-        &mut checks,
+        checks,
         "developability",
         worst_dev.0 <= worst_dev.2,
         match worst_dev.1 {
@@ -635,44 +778,54 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             None => "no interior vertices".into(),
         },
     );
+}
 
-    // Fold angles of a frame against its geometry: the worst (difference, edge, allowed).
-    let angle_errors = |coords: &[[f64; 3]], given: &[Option<f64>], delta: f64| {
-        let geo = adj.fold_angles(&f.faces, coords);
-        let mut w: (f64, Option<usize>, f64) = (0.0, None, 0.0);
-        for i in 0..f.edges.len() {
-            let (Some(g), Some(r)) = (given[i], geo[i]) else {
-                continue;
-            };
-            let diff = super::fold::wrap((g - r.to_degrees()).to_radians())
-                .to_degrees()
-                .abs();
-            let tilt = match (adj.left[i].as_slice(), adj.right[i].as_slice()) {
-                ([l], [r]) => {
-                    4.0 * (delta + d0)
-                        * (1.0 / face_height[*l].max(f64::MIN_POSITIVE)
-                            + 1.0 / face_height[*r].max(f64::MIN_POSITIVE))
-                }
-                _ => 0.0,
-            };
-            let allowed = opts.angle_tol_deg + tilt.to_degrees();
-            if diff - allowed > w.0 - w.2 || w.1.is_none() {
-                w = (diff, Some(i), allowed);
+/// Fold angles of a frame (coordinates `coords`, rounding error `delta`) against its
+/// geometry: the worst (difference, edge, allowed), in degrees.
+fn angle_errors(
+    s: &Sheet,
+    adj: &EdgeFaces,
+    coords: &[[f64; 3]],
+    given: &[Option<f64>],
+    delta: f64,
+) -> (f64, Option<usize>, f64) {
+    let geo = adj.fold_angles(&s.f.faces, coords);
+    let mut w: (f64, Option<usize>, f64) = (0.0, None, 0.0);
+    for i in 0..s.f.edges.len() {
+        let (Some(g), Some(r)) = (given[i], geo[i]) else {
+            continue;
+        };
+        let diff = super::fold::wrap((g - r.to_degrees()).to_radians())
+            .to_degrees()
+            .abs();
+        let tilt = match (adj.left[i].as_slice(), adj.right[i].as_slice()) {
+            ([l], [r]) => {
+                4.0 * (delta + s.d0)
+                    * (1.0 / s.face_height[*l].max(f64::MIN_POSITIVE)
+                        + 1.0 / s.face_height[*r].max(f64::MIN_POSITIVE))
             }
+            _ => 0.0,
+        };
+        let allowed = s.opts.angle_tol_deg + tilt.to_degrees();
+        if diff - allowed > w.0 - w.2 || w.1.is_none() {
+            w = (diff, Some(i), allowed);
         }
-        w
-    };
+    }
+    w
+}
 
-    // Frame 0's fold angles: the target of a crease pattern (their signs against the
-    // assignment), or the geometry of a folded frame 0.
+/// Frame 0's fold angles: the target of a crease pattern (their signs against the
+/// assignment), or the geometry of a folded frame 0.
+fn check_key_fold_angles(s: &Sheet, adj: &EdgeFaces, key_frame: KeyFrame, checks: &mut Vec<Check>) {
+    let (f, opts) = (s.f, s.opts);
     match (&f.frames[0].fold_angles, key_frame) {
         (None, _) => not_checked_push(
-            &mut checks,
+            checks,
             "fold angles of frame 0",
             "the file has no edges_foldAngle".into(),
         ),
         (Some(_), KeyFrame::CreasePattern) if f.assignment_derived => not_checked_push(
-            &mut checks,
+            checks,
             "assignment vs fold angle",
             "the file has no edges_assignment: mountain and valley are not stated".into(),
         ),
@@ -702,7 +855,7 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             });
         }
         (Some(angles), _) => {
-            let (diff, edge, allowed) = angle_errors(key, angles, 0.0);
+            let (diff, edge, allowed) = angle_errors(s, adj, s.key, angles, 0.0);
             checks.push(Check {
                 name: "fold angles vs geometry".into(),
                 ok: diff <= allowed,
@@ -716,32 +869,16 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             });
         }
     }
+}
 
-    // Folded frames: isometric to frame 0 (distances within faces), fold angles as stated.
+/// Folded frames: isometric to frame 0 (distances within faces), fold angles as stated.
+fn check_frames(s: &Sheet, adj: &EdgeFaces) -> Vec<FrameCheck> {
     let mut frames = Vec::new();
-    for (k, fr) in f.frames.iter().enumerate().skip(1) {
-        let mut worst_iso = (0.0f64, None, 0.0);
-        for (fi, fc) in f.faces.iter().enumerate() {
-            let s = face_size[fi];
-            let allowed = opts.tol + 4.0 * (d0 + delta[k]) / s.max(f64::MIN_POSITIVE);
-            for i in 0..fc.len() {
-                for j in i + 1..fc.len() {
-                    let d0 = geom::dist(key[fc[i]], key[fc[j]]);
-                    let d1 = geom::dist(fr.coords[fc[i]], fr.coords[fc[j]]);
-                    let err = if s > 0.0 {
-                        (d1 - d0).abs() / s
-                    } else {
-                        f64::INFINITY
-                    };
-                    if err - allowed > worst_iso.0 - worst_iso.2 || worst_iso.1.is_none() {
-                        worst_iso = (err, Some(fi), allowed);
-                    }
-                }
-            }
-        }
+    for (k, fr) in s.f.frames.iter().enumerate().skip(1) {
+        let worst_iso = isometry_error(s, k, &fr.coords);
         let mut worst_angle = None;
         if let (Some(given), true) = (&fr.fold_angles, fr.fold_angles_own) {
-            worst_angle = Some(angle_errors(&fr.coords, given, delta[k]));
+            worst_angle = Some(angle_errors(s, adj, &fr.coords, given, s.delta[k]));
         }
         let ok = worst_iso.0 <= worst_iso.2 && worst_angle.is_none_or(|w| w.0 <= w.2);
         frames.push(FrameCheck {
@@ -754,37 +891,33 @@ pub fn verify(f: &FoldFile, opts: &VerifyOptions) -> VerifyReport {
             ok,
         });
     }
-    if frames.is_empty() {
-        not_checked_push(
-            &mut checks,
-            "folded frames",
-            "the file has no frames after frame 0: no motion to check".into(),
-        );
-    }
+    frames
+}
 
-    let ok = checks.iter().all(|c| c.ok) && frames.iter().all(|fr| fr.ok);
-    VerifyReport {
-        file: f.source.clone(),
-        ok,
-        vertices: n,
-        edges: f.edges.len(),
-        faces: f.faces.len(),
-        faces_derived: f.faces_derived,
-        edges_derived: f.edges_derived,
-        assignment_derived: f.assignment_derived,
-        key_frame,
-        plane: plane.filter(|_| planar).map(|(c, _)| {
-            [
-                c,
-                reference.unwrap_or_else(|| plane.map_or([0.0, 0.0, 1.0], |p| p.1)),
-            ]
-        }),
-        tol: opts.tol,
-        angle_tol_deg: opts.angle_tol_deg,
-        precision: prec,
-        checks,
-        frames,
+/// Frame `k` (at `coords`) against frame 0: the worst relative change of a distance within
+/// a face as (error, face, allowed).
+fn isometry_error(s: &Sheet, k: usize, coords: &[[f64; 3]]) -> (f64, Option<usize>, f64) {
+    let key = s.key;
+    let mut worst_iso = (0.0f64, None, 0.0);
+    for (fi, fc) in s.f.faces.iter().enumerate() {
+        let size = s.face_size[fi];
+        let allowed = s.opts.tol + 4.0 * (s.d0 + s.delta[k]) / size.max(f64::MIN_POSITIVE);
+        for i in 0..fc.len() {
+            for j in i + 1..fc.len() {
+                let d0 = geom::dist(key[fc[i]], key[fc[j]]);
+                let d1 = geom::dist(coords[fc[i]], coords[fc[j]]);
+                let err = if size > 0.0 {
+                    (d1 - d0).abs() / size
+                } else {
+                    f64::INFINITY
+                };
+                if err - allowed > worst_iso.0 - worst_iso.2 || worst_iso.1.is_none() {
+                    worst_iso = (err, Some(fi), allowed);
+                }
+            }
+        }
     }
+    worst_iso
 }
 
 /// `x` rounded to 4 decimals for a message, without a "-0.0000".

@@ -269,6 +269,12 @@ fn scale(v: [f64; 3]) -> Option<f64> {
 
 /// One safeguarded step of the Moré–Thuente interval update (MINPACK's `dcstep` as argmin
 /// 0.11 ports it). `None` where argmin reports a NaN or an infinity.
+///
+/// MINPACK writes it as one routine: the trial step from four cases (Moré and Thuente
+/// 1994, Sec. 4), then the new interval of uncertainty. Here each case is a function of its
+/// own, named by its condition, with the arithmetic of its branch unchanged (argmin's
+/// operations in argmin's order); this function keeps the case analysis and the update, so
+/// the published structure stays visible in one screen.
 fn cstep(
     stx: Step,
     sty: Step,
@@ -277,114 +283,25 @@ fn cstep(
     stpmin: f64,
     stpmax: f64,
 ) -> Option<(Step, Step, Step, bool, usize)> {
-    let mut info = 0;
-    let bound: bool;
-    let mut stpf: f64;
-    let stpc: f64;
-    let stpq: f64;
-    let mut brackt = brackt;
     if (brackt && (stp.x <= stx.x.min(sty.x) || stp.x >= stx.x.max(sty.x)))
         || stx.gx * (stp.x - stx.x) >= 0.0
         || stpmax < stpmin
     {
-        return Some((stx, sty, stp, brackt, info));
+        return Some((stx, sty, stp, brackt, 0));
     }
     let sgnd = stp.gx * (stx.gx / stx.gx.abs());
-    if stp.fx > stx.fx {
-        info = 1;
-        bound = true;
-        let theta = 3.0 * (stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx + stp.gx;
-        let s = scale([theta, stx.gx, stp.gx])?;
-        let mut gamma = s * ((theta / s).powi(2) - (stx.gx / s) * (stp.gx / s)).sqrt();
-        if stp.x < stx.x {
-            gamma = -gamma;
-        }
-        let p = (gamma - stx.gx) + theta;
-        let q = ((gamma - stx.gx) + gamma) + stp.gx;
-        let r = p / q;
-        stpc = stx.x + r * (stp.x - stx.x);
-        stpq = stx.x
-            + ((stx.gx / ((stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx)) / 2.0) * (stp.x - stx.x);
-        if (stpc - stx.x).abs() < (stpq - stx.x).abs() {
-            stpf = stpc;
-        } else {
-            stpf = stpc + (stpq - stpc) / 2.0;
-        }
-        brackt = true;
+    // (info, whether the step is kept inside the interval, brackt, the trial step)
+    let (info, bound, brackt, mut stpf) = if stp.fx > stx.fx {
+        (1, true, true, higher_value(stx, stp)?)
     } else if sgnd < 0.0 {
-        info = 2;
-        bound = false;
-        let theta = 3.0 * (stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx + stp.gx;
-        let s = scale([theta, stx.gx, stp.gx])?;
-        let mut gamma = s * ((theta / s).powi(2) - (stx.gx / s) * (stp.gx / s)).sqrt();
-        if stp.x > stx.x {
-            gamma = -gamma;
-        }
-        let p = (gamma - stp.gx) + theta;
-        let q = ((gamma - stp.gx) + gamma) + stx.gx;
-        let r = p / q;
-        stpc = stp.x + r * (stx.x - stp.x);
-        stpq = stp.x + (stp.gx / (stp.gx - stx.gx)) * (stx.x - stp.x);
-        if (stpc - stp.x).abs() > (stpq - stp.x).abs() {
-            stpf = stpc;
-        } else {
-            stpf = stpq;
-        }
-        brackt = true;
+        (2, false, true, slopes_of_opposite_sign(stx, stp)?)
     } else if stp.gx.abs() < stx.gx.abs() {
-        info = 3;
-        bound = true;
-        let theta = 3.0 * (stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx + stp.gx;
-        let s = scale([theta, stx.gx, stp.gx])?;
-        let mut gamma = s * 0.0f64
-            .max((theta / s).powi(2) - (stx.gx / s) * (stp.gx / s))
-            .sqrt();
-        if stp.x > stx.x {
-            gamma = -gamma;
-        }
-        let p = (gamma - stp.gx) + theta;
-        let q = (gamma + (stx.gx - stp.gx)) + gamma;
-        let r = p / q;
-        if r < 0.0 && gamma != 0.0 {
-            stpc = stp.x + r * (stx.x - stp.x);
-        } else if stp.x > stx.x {
-            stpc = stpmax;
-        } else {
-            stpc = stpmin;
-        }
-        stpq = stp.x + (stp.gx / (stp.gx - stx.gx)) * (stx.x - stp.x);
-        if brackt {
-            if (stp.x - stpc).abs() < (stp.x - stpq).abs() {
-                stpf = stpc;
-            } else {
-                stpf = stpq;
-            }
-        } else if (stp.x - stpc).abs() > (stp.x - stpq).abs() {
-            stpf = stpc;
-        } else {
-            stpf = stpq;
-        }
+        let stpf = slope_shrinks(stx, stp, brackt, stpmin, stpmax)?;
+        (3, true, brackt, stpf)
     } else {
-        info = 4;
-        bound = false;
-        if brackt {
-            let theta = 3.0 * (stp.fx - sty.fx) / (sty.x - stp.x) + sty.gx + stp.gx;
-            let s = scale([theta, sty.gx, stp.gx])?;
-            let mut gamma = s * ((theta / s).powi(2) - (sty.gx / s) * (stp.gx / s)).sqrt();
-            if stp.x > sty.x {
-                gamma = -gamma;
-            }
-            let p = (gamma - stp.gx) + theta;
-            let q = ((gamma - stp.gx) + gamma) + sty.gx;
-            let r = p / q;
-            stpc = stp.x + r * (sty.x - stp.x);
-            stpf = stpc;
-        } else if stp.x > stx.x {
-            stpf = stpmax;
-        } else {
-            stpf = stpmin;
-        }
-    }
+        let stpf = slope_does_not_shrink(stx, sty, stp, brackt, stpmin, stpmax)?;
+        (4, false, brackt, stpf)
+    };
     // The new interval of uncertainty.
     let mut stx_o = stx;
     let mut sty_o = sty;
@@ -408,6 +325,113 @@ fn cstep(
         }
     }
     Some((stx_o, sty_o, stp_o, brackt, info))
+}
+
+/// `cstep`'s first case, a higher value than at `stx`: the minimum is bracketed; the cubic
+/// step if it is closer to `stx` than the quadratic one, else their midpoint.
+fn higher_value(stx: Step, stp: Step) -> Option<f64> {
+    let theta = 3.0 * (stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx + stp.gx;
+    let s = scale([theta, stx.gx, stp.gx])?;
+    let mut gamma = s * ((theta / s).powi(2) - (stx.gx / s) * (stp.gx / s)).sqrt();
+    if stp.x < stx.x {
+        gamma = -gamma;
+    }
+    let p = (gamma - stx.gx) + theta;
+    let q = ((gamma - stx.gx) + gamma) + stp.gx;
+    let r = p / q;
+    let stpc = stx.x + r * (stp.x - stx.x);
+    let stpq =
+        stx.x + ((stx.gx / ((stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx)) / 2.0) * (stp.x - stx.x);
+    Some(if (stpc - stx.x).abs() < (stpq - stx.x).abs() {
+        stpc
+    } else {
+        stpc + (stpq - stpc) / 2.0
+    })
+}
+
+/// `cstep`'s second case, a lower value and slopes of opposite sign: the minimum is
+/// bracketed; the cubic step if it is farther from `stp` than the secant step, else that.
+fn slopes_of_opposite_sign(stx: Step, stp: Step) -> Option<f64> {
+    let theta = 3.0 * (stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx + stp.gx;
+    let s = scale([theta, stx.gx, stp.gx])?;
+    let mut gamma = s * ((theta / s).powi(2) - (stx.gx / s) * (stp.gx / s)).sqrt();
+    if stp.x > stx.x {
+        gamma = -gamma;
+    }
+    let p = (gamma - stp.gx) + theta;
+    let q = ((gamma - stp.gx) + gamma) + stx.gx;
+    let r = p / q;
+    let stpc = stp.x + r * (stx.x - stp.x);
+    let stpq = stp.x + (stp.gx / (stp.gx - stx.gx)) * (stx.x - stp.x);
+    Some(if (stpc - stp.x).abs() > (stpq - stp.x).abs() {
+        stpc
+    } else {
+        stpq
+    })
+}
+
+/// `cstep`'s third case, a lower value, slopes of the same sign, the slope's magnitude
+/// shrinking: the cubic step only if the cubic tends to infinity in the step's direction
+/// (else the bound), then the one closer to `stp` (bracketed) or farther (not).
+fn slope_shrinks(stx: Step, stp: Step, brackt: bool, stpmin: f64, stpmax: f64) -> Option<f64> {
+    let theta = 3.0 * (stx.fx - stp.fx) / (stp.x - stx.x) + stx.gx + stp.gx;
+    let s = scale([theta, stx.gx, stp.gx])?;
+    let mut gamma = s * 0.0f64
+        .max((theta / s).powi(2) - (stx.gx / s) * (stp.gx / s))
+        .sqrt();
+    if stp.x > stx.x {
+        gamma = -gamma;
+    }
+    let p = (gamma - stp.gx) + theta;
+    let q = (gamma + (stx.gx - stp.gx)) + gamma;
+    let r = p / q;
+    let stpc = if r < 0.0 && gamma != 0.0 {
+        stp.x + r * (stx.x - stp.x)
+    } else if stp.x > stx.x {
+        stpmax
+    } else {
+        stpmin
+    };
+    let stpq = stp.x + (stp.gx / (stp.gx - stx.gx)) * (stx.x - stp.x);
+    Some(if brackt {
+        if (stp.x - stpc).abs() < (stp.x - stpq).abs() {
+            stpc
+        } else {
+            stpq
+        }
+    } else if (stp.x - stpc).abs() > (stp.x - stpq).abs() {
+        stpc
+    } else {
+        stpq
+    })
+}
+
+/// `cstep`'s fourth case, a lower value, slopes of the same sign, the slope's magnitude not
+/// shrinking: the cubic step between `stp` and `sty` when bracketed, else a bound.
+fn slope_does_not_shrink(
+    stx: Step,
+    sty: Step,
+    stp: Step,
+    brackt: bool,
+    stpmin: f64,
+    stpmax: f64,
+) -> Option<f64> {
+    Some(if brackt {
+        let theta = 3.0 * (stp.fx - sty.fx) / (sty.x - stp.x) + sty.gx + stp.gx;
+        let s = scale([theta, sty.gx, stp.gx])?;
+        let mut gamma = s * ((theta / s).powi(2) - (sty.gx / s) * (stp.gx / s)).sqrt();
+        if stp.x > sty.x {
+            gamma = -gamma;
+        }
+        let p = (gamma - stp.gx) + theta;
+        let q = ((gamma - stp.gx) + gamma) + sty.gx;
+        let r = p / q;
+        stp.x + r * (sty.x - stp.x)
+    } else if stp.x > stx.x {
+        stpmax
+    } else {
+        stpmin
+    })
 }
 
 #[cfg(test)]

@@ -254,6 +254,17 @@ struct Transform {
 }
 
 impl Transform {
+    /// The starting point for `u` in the unit cube; it stays off the bounds, where the
+    /// transform's slope vanishes.
+    fn start(&self, u: &[f64]) -> Vec<f64> {
+        u.iter()
+            .enumerate()
+            .map(|(i, u)| {
+                let (l, h) = (self.lo[i], self.hi[i]);
+                l + (h - l) * (0.02 + 0.96 * u)
+            })
+            .collect()
+    }
     fn x(&self, y: &[f64]) -> Vec<f64> {
         let mut x = Vec::with_capacity(y.len());
         self.x_into(y, &mut x, None);
@@ -628,15 +639,7 @@ pub fn minimize_shared<P: Problem>(
     let mut replayed_evaluations = 0;
     for (start, u) in points.iter().enumerate() {
         starts_run = start + 1;
-        // Starting points stay off the bounds, where the transform's slope vanishes.
-        let x0: Vec<f64> = u
-            .iter()
-            .enumerate()
-            .map(|(i, u)| {
-                let (l, h) = (transform.lo[i], transform.hi[i]);
-                l + (h - l) * (0.02 + 0.96 * u)
-            })
-            .collect();
+        let x0 = transform.start(u);
         let mut al = Lagrangian {
             problem,
             transform: &transform,
@@ -648,53 +651,14 @@ pub fn minimize_shared<P: Problem>(
             eval: Evaluation::new(n, m),
             evaluations: 0,
         };
-        let met_a = match shared.and_then(|s| s.get(opts, start)) {
-            Some(a) => {
-                (al.y, al.lambda, al.mu) = (a.y, a.lambda, a.mu);
-                replayed_evaluations += a.evaluations;
-                a.met
+        let met_a = al.phase_a(shared, start, &mut replayed_evaluations);
+        let (robust_ok, robust_violation) = match robust {
+            Some(r) if met_a => {
+                let (ok, violation) = al.phase_b(r, &mut attempts);
+                (Some(ok), Some(violation))
             }
-            None => {
-                let before = counter.get();
-                let met = al.run(None, opts.max_outer, opts.max_inner);
-                if let Some(s) = shared {
-                    let a = PhaseA {
-                        y: al.y.clone(),
-                        lambda: al.lambda.clone(),
-                        mu: al.mu,
-                        met,
-                        evaluations: al.evaluations + counter.get() - before,
-                    };
-                    s.put(opts, start, a);
-                }
-                met
-            }
+            _ => (None, None),
         };
-        let mut robust_ok = None;
-        let mut robust_violation = None;
-        if let Some(r) = robust
-            && met_a
-        {
-            r.reset();
-            let x = transform.x(&al.y);
-            let v = r.update(&x, None);
-            let first = if v <= opts.feasibility_tol {
-                r.accept(&x)
-            } else {
-                Acceptance::Refined
-            };
-            let mut ok = first == Acceptance::Accepted;
-            if first == Acceptance::Refined && attempts < opts.robust_starts {
-                attempts += 1;
-                // Phase B: the block's constraints join, warm-started from phase A's optimum
-                // with its multipliers; μ restarts low so the new terms are not ill-conditioned.
-                al.mu = 10.0;
-                ok = al.run(Some(r), opts.robust_outer, opts.robust_inner);
-            }
-            let x = transform.x(&al.y);
-            robust_violation = Some(r.update(&x, None));
-            robust_ok = Some(ok);
-        }
         evaluations += al.evaluations;
         let x = transform.x(&al.y);
         problem.eval(&x, &mut al.eval);
@@ -720,22 +684,7 @@ pub fn minimize_shared<P: Problem>(
             starts_run: start + 1,
             evaluations,
         };
-        let rank = |s: &Solution| (s.robust == Some(true), s.met_target, s.feasible);
-        let better = match &best {
-            None => true,
-            Some(b) => match rank(&candidate).cmp(&rank(b)) {
-                std::cmp::Ordering::Greater => true,
-                std::cmp::Ordering::Less => false,
-                std::cmp::Ordering::Equal => {
-                    if candidate.feasible {
-                        candidate.f < b.f
-                    } else {
-                        candidate.violation < b.violation
-                    }
-                }
-            },
-        };
-        if better {
+        if best.as_ref().is_none_or(|b| candidate.better_than(b)) {
             best = Some(candidate);
         }
         let done = match robust {
@@ -752,6 +701,86 @@ pub fn minimize_shared<P: Problem>(
     best.evaluations = evaluations + counter.get() + replayed_evaluations;
     best.robust_attempts = attempts;
     best
+}
+
+impl Solution {
+    /// Whether this start's solution beats `b`: robust first, then meeting the target, then
+    /// feasible; among equals the lower objective (feasible) or violation (not).
+    fn better_than(&self, b: &Solution) -> bool {
+        let rank = |s: &Solution| (s.robust == Some(true), s.met_target, s.feasible);
+        match rank(self).cmp(&rank(b)) {
+            std::cmp::Ordering::Greater => true,
+            std::cmp::Ordering::Less => false,
+            std::cmp::Ordering::Equal => {
+                if self.feasible {
+                    self.f < b.f
+                } else {
+                    self.violation < b.violation
+                }
+            }
+        }
+    }
+}
+
+impl<P: Problem> Lagrangian<'_, P> {
+    /// Phase A of start `start`: replayed from `shared` when it holds it (adding the
+    /// evaluations it stands for to `replayed`), else run (and recorded there). Returns
+    /// whether it met the target.
+    fn phase_a(
+        &mut self,
+        shared: Option<&SharedStarts>,
+        start: usize,
+        replayed: &mut usize,
+    ) -> bool {
+        let opts = self.opts;
+        match shared.and_then(|s| s.get(opts, start)) {
+            Some(a) => {
+                (self.y, self.lambda, self.mu) = (a.y, a.lambda, a.mu);
+                *replayed += a.evaluations;
+                a.met
+            }
+            None => {
+                let before = self.counter.get();
+                let met = self.run(None, opts.max_outer, opts.max_inner);
+                if let Some(s) = shared {
+                    let a = PhaseA {
+                        y: self.y.clone(),
+                        lambda: self.lambda.clone(),
+                        mu: self.mu,
+                        met,
+                        evaluations: self.evaluations + self.counter.get() - before,
+                    };
+                    s.put(opts, start, a);
+                }
+                met
+            }
+        }
+    }
+
+    /// Phase B after a phase A that met the target: whether the block accepts the point
+    /// (after optimizing with its constraints, if it refined and `attempts` is below
+    /// [`Options::robust_starts`]; counted there), and the block's violation at the end.
+    fn phase_b(&mut self, r: &dyn Robust, attempts: &mut usize) -> (bool, f64) {
+        let opts = self.opts;
+        r.reset();
+        let x = self.transform.x(&self.y);
+        let v = r.update(&x, None);
+        let first = if v <= opts.feasibility_tol {
+            r.accept(&x)
+        } else {
+            Acceptance::Refined
+        };
+        let mut ok = first == Acceptance::Accepted;
+        if first == Acceptance::Refined && *attempts < opts.robust_starts {
+            *attempts += 1;
+            // Phase B: the block's constraints join, warm-started from phase A's optimum
+            // with its multipliers; μ restarts low so the new terms are not ill-conditioned.
+            self.mu = 10.0;
+            ok = self.run(Some(r), opts.robust_outer, opts.robust_inner);
+        }
+        let x = self.transform.x(&self.y);
+        (ok, r.update(&x, None))
+    }
 }
 
 #[cfg(test)]

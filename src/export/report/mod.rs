@@ -577,22 +577,7 @@ pub fn report_html(out_dir: &Path, input: &ReportInput) -> Result<String> {
     } else {
         sm.title.clone()
     };
-    let mut data = Vec::with_capacity(input.designs.len());
-    let mut ids = BTreeSet::new();
-    for (i, d) in input.designs.iter().enumerate() {
-        if !ids.insert(d.id.as_str()) {
-            return Err(ExportError::invalid(
-                format!("designs[{i}].id"),
-                format!("{:?} appears twice; design ids must be unique", d.id),
-            ));
-        }
-        validate_meta(&d.meta, &d.pattern)
-            .map_err(|e| ExportError::invalid(format!("design {}", d.id), e.to_string()))?;
-        data.push(
-            design_json(out_dir, d)
-                .map_err(|e| ExportError::invalid(format!("design {}", d.id), e.to_string()))?,
-        );
-    }
+    let data = designs_data(out_dir, input)?;
     let mut s = format!(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{}</title><style>{CSS}</style></head><body>\n<header><h1>{}</h1><div>task: {}</div></header>\n<main>\n",
         xml_escape(&title),
@@ -611,7 +596,55 @@ pub fn report_html(out_dir: &Path, input: &ReportInput) -> Result<String> {
         }
         s += "</tbody></table></section>\n";
     }
-    s += "<section id=\"summary\"><h2>Summary</h2>";
+    s += &summary_section(sm);
+    s += &designs_section(&input.designs);
+    if !input.tree.is_empty() {
+        let _ = writeln!(
+            s,
+            "<section id=\"tree\"><h2>Search tree</h2><div class=\"plot\">{}</div></section>",
+            search_tree_svg(&input.tree)?
+        );
+    }
+    if let Some(d) = &input.distribution {
+        let _ = writeln!(
+            s,
+            "<section id=\"distribution\"><h2>Designs over rule applications</h2><div class=\"plot\">{}</div></section>",
+            distribution_svg(d)?
+        );
+    }
+    s += "</main>\n";
+    let _ = write!(
+        s,
+        "<script type=\"application/json\" id=\"foldsynth-data\">{}</script>\n<script>{THREE_JS}</script>\n<script>{APP_JS}</script>\n</body></html>\n",
+        script_json(&json!({ "designs": data }))
+    );
+    Ok(s)
+}
+
+/// Every design's data for the page, its id unique and its metadata valid.
+fn designs_data(out_dir: &Path, input: &ReportInput) -> Result<Vec<Value>> {
+    let mut data = Vec::with_capacity(input.designs.len());
+    let mut ids = BTreeSet::new();
+    for (i, d) in input.designs.iter().enumerate() {
+        if !ids.insert(d.id.as_str()) {
+            return Err(ExportError::invalid(
+                format!("designs[{i}].id"),
+                format!("{:?} appears twice; design ids must be unique", d.id),
+            ));
+        }
+        validate_meta(&d.meta, &d.pattern)
+            .map_err(|e| ExportError::invalid(format!("design {}", d.id), e.to_string()))?;
+        data.push(
+            design_json(out_dir, d)
+                .map_err(|e| ExportError::invalid(format!("design {}", d.id), e.to_string()))?,
+        );
+    }
+    Ok(data)
+}
+
+/// The summary section: counts against the thesis, stage timings, notes.
+fn summary_section(sm: &ReportSummary) -> String {
+    let mut s = String::from("<section id=\"summary\"><h2>Summary</h2>");
     if !sm.counts.is_empty() {
         s +=
             "<table><thead><tr><th>count</th><th>foldsynth</th><th>thesis</th></tr></thead><tbody>";
@@ -646,17 +679,23 @@ pub fn report_html(out_dir: &Path, input: &ReportInput) -> Result<String> {
         s += "</ul>";
     }
     s += "</section>\n";
+    s
+}
+
+/// The designs section: the table of designs beside the card of the one selected.
+fn designs_section(designs: &[ReportDesign]) -> String {
+    let mut s = String::new();
     let _ = write!(
         s,
         "<section id=\"designs\"><h2>Feasible designs (<span id=\"shown\">{n}</span> of {n} shown)</h2>",
-        n = input.designs.len()
+        n = designs.len()
     );
-    if input.designs.is_empty() {
+    if designs.is_empty() {
         s += "<p>No design passed every check.</p>";
     } else {
         s += "<p class=\"hint\">Click a column to sort (again to reverse); the second row filters. Click a row to view the design.</p>";
         s += "<div class=\"split\"><div class=\"table-wrap\">";
-        s += &design_table(&input.designs);
+        s += &design_table(designs);
         s += "</div><article class=\"card\" id=\"detail\"><h3 id=\"detail-title\"></h3>\
 <div class=\"views\"><figure class=\"view3d\"><div id=\"view3d\"><canvas id=\"canvas3d\" width=\"640\" height=\"480\"></canvas><p id=\"no-webgl\" hidden>The 3D view needs WebGL, which this browser does not offer; the crease pattern and figures below still apply.</p></div>\
 <div class=\"controls\"><button type=\"button\" id=\"play\">play</button><input type=\"range\" id=\"t-slider\" min=\"0\" max=\"1\" step=\"0.01\" value=\"1\" aria-label=\"driving parameter t\"><output id=\"t-value\"></output></div>\
@@ -667,27 +706,7 @@ black dot and line: the gripping vertex and its path; green: targets and traject
 <table class=\"facts\" id=\"detail-facts\"><tbody></tbody></table><p class=\"files\" id=\"detail-files\"></p></article></div>";
     }
     s += "</section>\n";
-    if !input.tree.is_empty() {
-        let _ = writeln!(
-            s,
-            "<section id=\"tree\"><h2>Search tree</h2><div class=\"plot\">{}</div></section>",
-            search_tree_svg(&input.tree)?
-        );
-    }
-    if let Some(d) = &input.distribution {
-        let _ = writeln!(
-            s,
-            "<section id=\"distribution\"><h2>Designs over rule applications</h2><div class=\"plot\">{}</div></section>",
-            distribution_svg(d)?
-        );
-    }
-    s += "</main>\n";
-    let _ = write!(
-        s,
-        "<script type=\"application/json\" id=\"foldsynth-data\">{}</script>\n<script>{THREE_JS}</script>\n<script>{APP_JS}</script>\n</body></html>\n",
-        script_json(&json!({ "designs": data }))
-    );
-    Ok(s)
+    s
 }
 
 /// Write `out_dir/report.html` and return its path.
