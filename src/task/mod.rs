@@ -34,6 +34,7 @@ mod drive;
 mod initial;
 pub mod number;
 mod robustness;
+pub mod terms;
 
 use std::path::{Path, PathBuf};
 

@@ -185,10 +185,12 @@ pub enum CreaseRef {
     Into(VertexRef),
     /// A crease of G0, by its end vertices' ids (`"v1-v2"`, either order).
     Initial {
-        /// The ids as written.
-        from: String,
-        /// The other end.
-        to: String,
+        /// The crease as written (`"v1-v2"`).
+        name: String,
+        /// Index in G0's vertex list of one end.
+        a: usize,
+        /// Index of the other end.
+        b: usize,
     },
 }
 
