@@ -23,6 +23,7 @@ pub mod limits;
 pub mod model;
 pub mod optimize;
 pub mod pattern;
+pub mod scene;
 pub mod search;
 pub mod simulate;
 pub mod task;

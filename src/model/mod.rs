@@ -16,6 +16,7 @@ pub mod linalg;
 pub mod numeric;
 pub mod plan;
 pub mod robust;
+pub mod select;
 
 pub use plan::{Constraint, Plan, PlanError};
 

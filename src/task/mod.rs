@@ -43,6 +43,7 @@ mod objective;
 pub(crate) mod parse;
 mod robustness;
 mod rotation;
+pub mod terms;
 
 use std::path::PathBuf;
 
