@@ -49,16 +49,19 @@ fn the_gripper_task_carries_the_thesis_data() {
     assert_eq!(o.threshold, 1e-5);
     assert_eq!(o.targets.len(), 1);
     assert_eq!(
-        (o.targets[0].t, o.targets[0].point, o.targets[0].weight),
-        (PI / 2.0, [0.0, 0.0, 1.0], 1.0)
+        (o.targets[0].t, o.targets[0].point(), o.targets[0].weight),
+        (PI / 2.0, Some([0.0, 0.0, 1.0]), 1.0)
     );
     let ch = t.check.as_ref().unwrap();
     assert_eq!(ch.states, 16);
-    assert_eq!(ch.cylinders.len(), 1);
+    let cylinders: Vec<_> = t.scene.cylinders().collect();
+    assert_eq!(cylinders.len(), 1);
     assert_eq!(
-        (ch.cylinders[0].radius, ch.cylinders[0].a, ch.cylinders[0].b),
+        (cylinders[0].radius, cylinders[0].a, cylinders[0].b),
         (0.25, [0.0, -1.0, 0.5], [0.0, 1.0, 0.5])
     );
+    assert_eq!(t.scene.obstacles[0].name, "check.cylinders[0]");
+    assert_eq!(t.scene.copies, foldsynth::scene::Copies::about_z(2));
 }
 
 #[test]
@@ -72,11 +75,12 @@ fn the_robotic_arm_task_carries_the_trajectory() {
         let ti = i as f64 * PI / 20.0;
         assert!((tg.t - ti).abs() < 1e-15);
         let p = [1.0 + 2.0 * ti.cos(), 0.0, 2.0 * ti.sin()];
-        for (a, b) in tg.point.iter().zip(p) {
+        for (a, b) in tg.point().unwrap().iter().zip(p) {
             assert!((a - b).abs() < 1e-15, "target {i}");
         }
     }
-    assert!(t.check.as_ref().unwrap().cylinders.is_empty());
+    assert!(t.scene.obstacles.is_empty());
+    assert_eq!(t.scene.copies.n, 1);
 }
 
 const BASE: &str = r#"

@@ -11,20 +11,12 @@
 //! segment–line distance over the polygon's edges. Every step is closed form.
 
 use nalgebra::Vector3;
-use serde::{Deserialize, Serialize};
 
 use super::tri_tri::Tri;
 
-/// A finite solid cylinder: axis segment `a → b` and radius.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Cylinder {
-    /// One end of the axis segment (centre of one cap).
-    pub a: [f64; 3],
-    /// The other end of the axis segment (centre of the other cap).
-    pub b: [f64; 3],
-    /// Radius (> 0).
-    pub radius: f64,
-}
+/// A finite solid cylinder (defined with the other obstacle shapes in [`crate::scene`]);
+/// its judge is here.
+pub use crate::scene::Cylinder;
 
 impl Cylinder {
     /// The obstacle of the thesis's gripper task (Sec. 5.5, Fig. 46a): radius 0.25, axis

@@ -33,11 +33,7 @@ pub fn task(text: &str) -> bool {
     let Ok(e) = Enumeration::run_limited(&task, n_max, Filters::all(), 300) else {
         return true;
     };
-    let obstacles = task
-        .check
-        .as_ref()
-        .map(|c| c.cylinders.clone())
-        .unwrap_or_default();
+    let obstacles: Vec<_> = task.scene.cylinders().copied().collect();
     for node in e.meaningful().take(2) {
         for candidate in 0..3 {
             let Ok(model) = Model::new(&node.graph, &task, candidate) else {

@@ -120,15 +120,22 @@ impl Model {
         if objective.targets.is_empty() {
             return Err(err("the objective has no targets"));
         }
+        // Point targets of the gripping vertex: the thesis's objective (Eq. 37–38).
         let targets: Vec<Target> = objective
             .targets
             .iter()
-            .map(|t| Target {
-                t: t.t,
-                point: t.point,
-                weight: t.weight,
+            .map(|t| match (&t.vertex, t.point()) {
+                (crate::task::terms::VertexRef::Tip, Some(point)) => Ok(Target {
+                    t: t.t,
+                    point,
+                    weight: t.weight,
+                }),
+                _ => Err(err(&format!(
+                    "objective.targets[{}]: only point targets of the tip are modelled",
+                    t.entry
+                ))),
             })
-            .collect();
+            .collect::<Result<_, _>>()?;
         let candidates = plan
             .candidates
             .ok_or_else(|| err("the graph has no extended vertex to grip with"))?;

@@ -117,8 +117,8 @@ impl RobustSpec {
             settings: task.robustness,
             states: check.map_or(crate::task::DEFAULT_OPTIMIZE_STATES, |c| c.optimize_states),
             sweep: sweep.max(2),
-            second_arm: check.is_some_and(|c| c.second_arm),
-            cylinders: check.map(|c| c.cylinders.clone()).unwrap_or_default(),
+            second_arm: task.scene.copies.n == 2,
+            cylinders: task.scene.cylinders().copied().collect(),
         }
     }
 }

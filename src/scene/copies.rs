@@ -49,7 +49,7 @@ impl Copies {
     /// The rotation of copy `k` (0 ≤ k < n; copy 0 is the arm itself).
     pub fn rotation(&self, k: usize) -> Mat3 {
         let k = k % self.n.max(1);
-        if self.is_z() && (4 * k) % self.n.max(1) == 0 {
+        if self.is_z() && (4 * k).is_multiple_of(self.n.max(1)) {
             // A multiple of a quarter turn about z: exact.
             let (c, s) = match (4 * k / self.n.max(1)) % 4 {
                 0 => (1.0, 0.0),
@@ -65,7 +65,7 @@ impl Copies {
 
     /// Point `p` of the arm, moved to copy `k`.
     pub fn apply(&self, k: usize, p: V3) -> V3 {
-        if k % self.n.max(1) == 0 {
+        if k.is_multiple_of(self.n.max(1)) {
             return p;
         }
         let r = self.rotation(k);
@@ -75,7 +75,7 @@ impl Copies {
 
     /// A direction (or a gradient) of the arm, turned to copy `k` (no translation).
     pub fn turn(&self, k: usize, v: V3) -> V3 {
-        if k % self.n.max(1) == 0 {
+        if k.is_multiple_of(self.n.max(1)) {
             return v;
         }
         mul(&self.rotation(k), v)
@@ -84,7 +84,7 @@ impl Copies {
     /// A direction of copy `k` turned back to the arm: `Rᵀ v` (a gradient with respect to
     /// copy k's point is `Rᵀ` times the gradient with respect to the arm's point).
     pub fn turn_back(&self, k: usize, v: V3) -> V3 {
-        if k % self.n.max(1) == 0 {
+        if k.is_multiple_of(self.n.max(1)) {
             return v;
         }
         let r = self.rotation(k);

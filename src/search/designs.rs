@@ -296,11 +296,8 @@ pub fn model_meta(task: &Task, model: &Model, modes: &[String], objective: f64) 
         } else {
             Vec::new()
         },
-        obstacle: task
-            .check
-            .as_ref()
-            .and_then(|c| c.cylinders.first().copied()),
-        second_arm: task.check.as_ref().is_some_and(|c| c.second_arm),
+        obstacle: task.scene.cylinders().next().copied(),
+        second_arm: task.scene.copies.n == 2,
         extra: BTreeMap::new(),
     }
 }

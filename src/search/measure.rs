@@ -10,16 +10,13 @@ use crate::task::Task;
 
 /// The obstacles of the task as the checks take them.
 pub(super) fn obstacles(task: &Task) -> Vec<Cylinder> {
-    task.check
-        .as_ref()
-        .map(|c| c.cylinders.clone())
-        .unwrap_or_default()
+    task.scene.cylinders().copied().collect()
 }
 
 /// The pattern checks and exports work on: the arm, with its rotated copy for two-armed
 /// tasks.
 pub(super) fn checked_pattern(task: &Task, arm: &Pattern) -> Result<Pattern, String> {
-    if task.check.as_ref().is_some_and(|c| c.second_arm) {
+    if task.scene.copies.n == 2 {
         two_armed(arm).map_err(|e| e.to_string())
     } else {
         Ok(arm.clone())

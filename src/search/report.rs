@@ -175,7 +175,10 @@ fn problem_facts(task: &Task, f: &mut Vec<Fact>) {
                 } else {
                     format!(", weight {}", n4(t.weight))
                 };
-                format!("{} at t = {}{w}", point(t.point), n4(t.t))
+                match t.point() {
+                    Some(p) => format!("{} at t = {}{w}", point(p), n4(t.t)),
+                    None => format!("{:?} at t = {}{w}", t.goal, n4(t.t)),
+                }
             })
             .collect();
         f.push(Fact::new(
@@ -201,14 +204,14 @@ fn check_facts(task: &Task, f: &mut Vec<Fact>) {
             format!(
                 "{} states over [0, t_max]{}",
                 c.states,
-                if c.second_arm {
+                if task.scene.copies.n == 2 {
                     "; two-armed: the arm and its copy rotated 180° about z"
                 } else {
                     ""
                 }
             ),
         ));
-        for (i, cy) in c.cylinders.iter().enumerate() {
+        for (i, cy) in task.scene.cylinders().enumerate() {
             f.push(Fact::new(
                 format!("obstacle {}", i + 1),
                 format!(

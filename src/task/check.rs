@@ -4,20 +4,15 @@ use serde::Deserialize;
 
 use super::{Ctx, Number, TaskError};
 
-/// A cylinder obstacle (axis segment `a → b` and radius): the checks' own type, so the
-/// task, the intersection check and the pictures share one definition.
-pub use crate::check::Cylinder;
+/// A cylinder obstacle (axis segment `a → b` and radius): one of the scene's shapes.
+pub use crate::scene::Cylinder;
+use crate::scene::{Copies, Obstacle, Shape};
 
 /// Intersection-check setup.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CheckSpec {
     /// Number of evenly spaced states over [0, t_max] to check (the thesis uses 16).
     pub states: usize,
-    /// Cylindrical obstacles.
-    pub cylinders: Vec<Cylinder>,
-    /// The design is one arm of a two-armed device: checks and pictures include a copy
-    /// rotated 180° about the z-axis (the gripper, Sec. 5.5.1).
-    pub second_arm: bool,
     /// Number of evenly spaced states over [0, t_max] at which the optimizer imposes the
     /// clearance and margin constraints (more are added where a finer sweep finds the
     /// design closer than allowed).
@@ -46,8 +41,28 @@ struct RawCylinder {
     to: Vec<Number>,
 }
 
-pub(crate) fn build(cx: &Ctx<'_>, raw: Option<&RawCheck>) -> Result<Option<CheckSpec>, TaskError> {
-    let Some(c) = raw else { return Ok(None) };
+/// What the `[check]` table says about the scene: the legacy `[[check.cylinders]]`
+/// (obstacles `check.cylinders[k]`) and `second_arm = true` (two copies about z, the
+/// thesis's gripper, Sec. 5.5.1).
+pub(crate) struct LegacyScene {
+    /// The cylinders, in file order.
+    pub(crate) obstacles: Vec<Obstacle>,
+    /// `second_arm = true`.
+    pub(crate) copies: Option<Copies>,
+}
+
+/// The check setup and what it says about the scene.
+pub(crate) fn build(
+    cx: &Ctx<'_>,
+    raw: Option<&RawCheck>,
+) -> Result<(Option<CheckSpec>, LegacyScene), TaskError> {
+    let mut legacy = LegacyScene {
+        obstacles: Vec::new(),
+        copies: None,
+    };
+    let Some(c) = raw else {
+        return Ok((None, legacy));
+    };
     let max = crate::limits::STATES_MAX as i64;
     if !(2..=max).contains(&c.states) {
         return Err(cx.err(
@@ -68,16 +83,18 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: Option<&RawCheck>) -> Result<Option<Check
             ),
         ));
     }
-    let mut cylinders = Vec::new();
     for (i, cy) in c.cylinders.iter().enumerate() {
-        cylinders.push(cylinder(cx, i, cy)?);
+        legacy.obstacles.push(Obstacle {
+            name: format!("check.cylinders[{i}]"),
+            shape: Shape::Cylinder(cylinder(cx, i, cy)?),
+        });
     }
-    Ok(Some(CheckSpec {
+    legacy.copies = c.second_arm.then(|| Copies::about_z(2));
+    let check = CheckSpec {
         states: c.states as usize,
-        cylinders,
-        second_arm: c.second_arm,
         optimize_states: optimize_states as usize,
-    }))
+    };
+    Ok((Some(check), legacy))
 }
 
 /// Obstacle `i`: a positive radius, an axis of two distinct points.

@@ -55,10 +55,10 @@ pub use initial::{InitialCrease, InitialGraph, InitialVertex, VertexType};
 pub(crate) use mirror::mirror_map;
 pub use motion::Motion;
 pub use number::Number;
-pub use objective::{Objective, Target};
 pub use robustness::{
     DEFAULT_CLEARANCE, DEFAULT_MIN_FEATURE, DEFAULT_RIGID_MARGIN, MAX_RIGID_MARGIN, Robustness,
 };
+pub use terms::{Objective, Target};
 
 /// A task file that failed to load: the file, the field (a TOML path such as
 /// `initial_graph.creases[0].drive`) and what is wrong / what is allowed.
@@ -100,6 +100,10 @@ pub struct Task {
     pub objective: Option<Objective>,
     /// Intersection-check setup (Sec. 5.4.2), if given.
     pub check: Option<CheckSpec>,
+    /// The world around the arm: obstacles, rotational copies, boxes to stay inside.
+    pub scene: crate::scene::Scene,
+    /// Hard requirements besides the scene and the margins: orientations, fold limits.
+    pub requirements: terms::Requirements,
     /// Margins the optimizer keeps over the whole motion (`[robustness]`, defaults when
     /// absent).
     pub robustness: Robustness,

@@ -2,27 +2,8 @@
 
 use serde::Deserialize;
 
+use super::terms::{Goal, Objective, Target, VertexRef};
 use super::{Ctx, Motion, Number, TaskError};
-
-/// Ω = Σ_i w_i ‖P_i − X_g(t_i)‖ over the targets; success when Ω* ≤ threshold.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Objective {
-    /// Points the gripping vertex should reach at given t.
-    pub targets: Vec<Target>,
-    /// Success threshold ϑ.
-    pub threshold: f64,
-}
-
-/// One point to reach at one value of t.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Target {
-    /// The driving parameter.
-    pub t: f64,
-    /// The 3D point.
-    pub point: [f64; 3],
-    /// Weight in the objective (1 unless given).
-    pub weight: f64,
-}
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -74,7 +55,12 @@ pub(crate) fn build(
     for (i, t) in o.targets.iter().enumerate() {
         targets.push(target(cx, i, t, lo, hi)?);
     }
-    Ok(Some(Objective { targets, threshold }))
+    Ok(Some(Objective {
+        targets,
+        threshold,
+        surfaces: Vec::new(),
+        area: None,
+    }))
 }
 
 /// Target `i`, its t within [lo, hi].
@@ -100,7 +86,9 @@ fn target(cx: &Ctx<'_>, i: usize, t: &RawTarget, lo: f64, hi: f64) -> Result<Tar
     }
     Ok(Target {
         t: tv,
-        point,
+        vertex: VertexRef::Tip,
+        goal: Goal::Point { point },
         weight,
+        entry: i,
     })
 }

@@ -119,7 +119,12 @@ impl<'a> Draft<'a> {
         let motion = motion::build(&cx, raw.motion.as_ref())?;
         let bounds = bounds::build(&cx, raw.bounds.as_ref())?;
         let objective = objective::build(&cx, raw.objective.as_ref(), motion)?;
-        let check = check::build(&cx, raw.check.as_ref())?;
+        let (check, legacy) = check::build(&cx, raw.check.as_ref())?;
+        let scene = crate::scene::Scene {
+            obstacles: legacy.obstacles,
+            copies: legacy.copies.unwrap_or_default(),
+            containment: Vec::new(),
+        };
         let robustness = robustness::build(&cx, raw.robustness.as_ref(), &initial)?;
 
         Ok(Task {
@@ -134,6 +139,8 @@ impl<'a> Draft<'a> {
             bounds,
             objective,
             check,
+            scene,
+            requirements: Default::default(),
             robustness,
             kawasaki: constraints::kawasaki(raw.constraints.as_ref()),
         })
