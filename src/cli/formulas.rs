@@ -3,6 +3,7 @@
 //! and operation counts; and the model formulas that `foldsynth model --formulas` prints
 //! ([`model_formulas`]).
 
+pub use crate::bench::symbolica::NO_SYMBOLICA;
 use crate::compile::simplify::{self, Limits};
 use crate::compile::{gradients, vertex::VertexModel};
 use crate::expr::{Counts, ExprGraph, Format, Names, NodeId, print::print};
@@ -268,9 +269,6 @@ fn render_symbolica(args: &FormulasArgs) -> Result<String> {
 fn render_symbolica(_: &FormulasArgs) -> Result<String> {
     bail!("{}", NO_SYMBOLICA)
 }
-
-/// The error of every Symbolica option in a build without the feature.
-pub const NO_SYMBOLICA: &str = "this foldsynth was built without Symbolica; rebuild with `cargo build --release --features symbolica`";
 
 /// Write `text` to `path` (saying so on stderr), or to standard output.
 pub fn emit(text: &str, path: Option<&Path>) -> Result<()> {
