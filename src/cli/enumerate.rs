@@ -9,7 +9,8 @@ use anyhow::Context;
 use serde::Serialize;
 
 use crate::grammar::{
-    DOT_FOOTER, Enumeration, Filters, LevelCounts, Rules, Status, dot_header, dot_node,
+    DOT_FOOTER, Enumeration, Filters, Generated, LevelCounts, Rules, Status, Streamed, dot_header,
+    dot_node,
 };
 use crate::limits::N_MAX;
 use crate::task::Task;
@@ -81,6 +82,92 @@ struct CyclicSummary {
     alternatives: u64,
 }
 
+/// What the stream counts and keeps for the report.
+#[derive(Default)]
+struct Tally {
+    levels: Vec<LevelCounts>,
+    meaningful: Vec<Meaningful>,
+    alternatives: u64,
+    cyclic: CyclicSummary,
+}
+
+impl Tally {
+    /// Count `g`; its alternatives (0 unless meaningful) and whether it is cyclic.
+    fn count(&mut self, g: &Generated<'_>, rules: Rules) -> (u64, bool) {
+        LevelCounts::count(&mut self.levels, g.level, g.status);
+        let alt = if g.status == Status::Meaningful {
+            g.graph.alternatives()
+        } else {
+            0
+        };
+        self.alternatives += alt;
+        let is_cyclic = rules.r2p && g.graph.is_cyclic_pattern();
+        if is_cyclic {
+            self.cyclic.generated += 1;
+            self.cyclic.meaningful += usize::from(g.status == Status::Meaningful);
+            self.cyclic.alternatives += alt;
+        }
+        (alt, is_cyclic)
+    }
+}
+
+/// Where the graphs go as they stream: the DOT tree, the JSON list on stdout, or the
+/// text report's list of meaningful graphs.
+struct Sinks<'a, W: Write> {
+    dot: Option<(&'a PathBuf, BufWriter<std::fs::File>)>,
+    out: W,
+    json: bool,
+    rules: Rules,
+}
+
+impl<W: Write> Sinks<'_, W> {
+    /// Write `g` (with `alt` alternatives) to the tree and the JSON list, or keep it for
+    /// the text report.
+    fn write(
+        &mut self,
+        g: &Generated<'_>,
+        (alt, is_cyclic): (u64, bool),
+        meaningful: &mut Vec<Meaningful>,
+    ) -> std::io::Result<()> {
+        if let Some((_, w)) = &mut self.dot {
+            w.write_all(dot_node(g).as_bytes())?;
+        }
+        if self.json {
+            let entry = GraphEntry {
+                sequence: g.graph.sequence(),
+                level: g.level,
+                internal_vertices: g.graph.internal_count(),
+                status: g.status,
+                parent: g.parent,
+                alternatives: alt,
+                cyclic: self.rules.r2p.then_some(is_cyclic),
+            };
+            let sep = if g.index == 0 { "" } else { "," };
+            write!(self.out, "{sep}\n    {}", serde_json::to_string(&entry)?)?;
+        } else if g.status == Status::Meaningful {
+            meaningful.push(Meaningful {
+                sequence: g.graph.sequence(),
+                n: g.graph.internal_count(),
+                alternatives: alt,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// `--tree`: the DOT file, its header written.
+fn open_tree(
+    path: Option<&PathBuf>,
+    n_max: usize,
+) -> anyhow::Result<Option<(&PathBuf, BufWriter<std::fs::File>)>> {
+    let Some(path) = path else { return Ok(None) };
+    let f = std::fs::File::create(path)
+        .with_context(|| format!("cannot write the search tree to {}", path.display()))?;
+    let mut w = BufWriter::new(f);
+    w.write_all(dot_header(n_max).as_bytes())?;
+    Ok(Some((path, w)))
+}
+
 /// Run `foldsynth enumerate`. The graphs stream: each is written (JSON, DOT) or counted
 /// as it is generated and then dropped, so N_max = 5 and 6 run in bounded memory.
 pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
@@ -91,104 +178,39 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
         mirror: !args.no_mirror,
         validity: !args.no_validity,
     };
-    let mut dot = match &args.tree {
-        Some(path) => {
-            let f = std::fs::File::create(path)
-                .with_context(|| format!("cannot write the search tree to {}", path.display()))?;
-            let mut w = BufWriter::new(f);
-            w.write_all(dot_header(n_max).as_bytes())?;
-            Some((path, w))
-        }
-        None => None,
-    };
-    let json = args.format == Format::Json;
-    let mut out = BufWriter::new(std::io::stdout().lock());
-    if json {
-        // The graphs first (streamed), the totals after them.
-        out.write_all(b"{\n  \"graphs\": [")?;
-    }
-    let mut levels: Vec<LevelCounts> = Vec::new();
-    let mut meaningful: Vec<Meaningful> = Vec::new();
-    let mut alternatives = 0u64;
-    let mut failed: Option<std::io::Error> = None;
     let rules = args.rules;
-    let mut cyclic = CyclicSummary::default();
+    let mut sinks = Sinks {
+        dot: open_tree(args.tree.as_ref(), n_max)?,
+        out: BufWriter::new(std::io::stdout().lock()),
+        json: args.format == Format::Json,
+        rules,
+    };
+    if sinks.json {
+        // The graphs first (streamed), the totals after them.
+        sinks.out.write_all(b"{\n  \"graphs\": [")?;
+    }
+    let mut tally = Tally::default();
+    let mut failed: Option<std::io::Error> = None;
     let streamed = Enumeration::stream_with(&task, n_max, filters, rules, |g| {
-        LevelCounts::count(&mut levels, g.level, g.status);
-        let alt = if g.status == Status::Meaningful {
-            g.graph.alternatives()
-        } else {
-            0
-        };
-        alternatives += alt;
-        let is_cyclic = rules.r2p && g.graph.is_cyclic_pattern();
-        if is_cyclic {
-            cyclic.generated += 1;
-            cyclic.meaningful += usize::from(g.status == Status::Meaningful);
-            cyclic.alternatives += alt;
-        }
+        let counted = tally.count(&g, rules);
         if failed.is_some() {
             return;
         }
-        let written = (|| -> std::io::Result<()> {
-            if let Some((_, w)) = &mut dot {
-                w.write_all(dot_node(&g).as_bytes())?;
-            }
-            if json {
-                let entry = GraphEntry {
-                    sequence: g.graph.sequence(),
-                    level: g.level,
-                    internal_vertices: g.graph.internal_count(),
-                    status: g.status,
-                    parent: g.parent,
-                    alternatives: alt,
-                    cyclic: rules.r2p.then_some(is_cyclic),
-                };
-                let sep = if g.index == 0 { "" } else { "," };
-                write!(out, "{sep}\n    {}", serde_json::to_string(&entry)?)?;
-            } else if g.status == Status::Meaningful {
-                meaningful.push(Meaningful {
-                    sequence: g.graph.sequence(),
-                    n: g.graph.internal_count(),
-                    alternatives: alt,
-                });
-            }
-            Ok(())
-        })();
-        if let Err(e) = written {
+        if let Err(e) = sinks.write(&g, counted, &mut tally.meaningful) {
             failed = Some(e);
         }
     });
     if let Some(e) = failed {
         return Err(e).context("cannot write the enumeration");
     }
-    if let Some((path, mut w)) = dot {
+    if let Some((path, mut w)) = sinks.dot {
         w.write_all(DOT_FOOTER.as_bytes())
             .and_then(|_| w.flush())
             .with_context(|| format!("cannot write the search tree to {}", path.display()))?;
     }
-    let total = |f: fn(&LevelCounts) -> usize| levels.iter().map(f).sum::<usize>();
-    if json {
-        let mut tail = serde_json::json!({
-            "generated": streamed.generated,
-            "filtered": {
-                "isomorphic": total(|c| c.isomorphic),
-                "mirror": total(|c| c.mirror),
-                "invalid": total(|c| c.invalid),
-            },
-            "alternatives": alternatives,
-        });
-        if rules.r2p {
-            tail["rules"] = serde_json::json!(rules.names());
-            tail["cyclic"] = serde_json::to_value(&cyclic)?;
-        }
-        let tail = serde_json::to_string_pretty(&tail)?;
-        // The totals' fields, after the graphs, in the same object.
-        let fields = tail
-            .trim()
-            .trim_start_matches('{')
-            .trim_end_matches('}')
-            .trim_end();
+    let mut out = sinks.out;
+    if sinks.json {
+        let fields = json_totals(&streamed, &tally, rules)?;
         writeln!(out, "\n  ],{fields}\n}}")?;
     } else {
         let report = text_report(
@@ -197,10 +219,7 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
             n_max,
             filters,
             streamed.mirror_applied,
-            &levels,
-            &meaningful,
-            alternatives,
-            rules.r2p.then_some(&cyclic),
+            &tally,
         );
         out.write_all(report.as_bytes())?;
     }
@@ -208,22 +227,45 @@ pub fn run(args: EnumerateArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The totals' fields, to follow the graphs in the same JSON object.
+fn json_totals(streamed: &Streamed, tally: &Tally, rules: Rules) -> anyhow::Result<String> {
+    let total = |f: fn(&LevelCounts) -> usize| tally.levels.iter().map(f).sum::<usize>();
+    let mut tail = serde_json::json!({
+        "generated": streamed.generated,
+        "filtered": {
+            "isomorphic": total(|c| c.isomorphic),
+            "mirror": total(|c| c.mirror),
+            "invalid": total(|c| c.invalid),
+        },
+        "alternatives": tally.alternatives,
+    });
+    if rules.r2p {
+        tail["rules"] = serde_json::json!(rules.names());
+        tail["cyclic"] = serde_json::to_value(&tally.cyclic)?;
+    }
+    let tail = serde_json::to_string_pretty(&tail)?;
+    Ok(tail
+        .trim()
+        .trim_start_matches('{')
+        .trim_end_matches('}')
+        .trim_end()
+        .to_string())
+}
+
 fn on(b: bool) -> &'static str {
     if b { "on" } else { "off" }
 }
 
-#[allow(clippy::too_many_arguments)]
 fn text_report(
     task: &Task,
     args: &EnumerateArgs,
     n_max: usize,
     filters: Filters,
     mirror_applied: bool,
-    levels: &[LevelCounts],
-    meaningful: &[Meaningful],
-    alternatives: u64,
-    cyclic: Option<&CyclicSummary>,
+    tally: &Tally,
 ) -> String {
+    let (levels, meaningful, alternatives) = (&tally.levels, &tally.meaningful, tally.alternatives);
+    let cyclic = args.rules.r2p.then_some(&tally.cyclic);
     use std::fmt::Write as _;
     let mut s = String::new();
     let _ = writeln!(

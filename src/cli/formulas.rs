@@ -3,6 +3,7 @@
 //! and operation counts; and the model formulas that `foldsynth model --formulas` prints
 //! ([`model_formulas`]).
 
+pub use crate::bench::symbolica::NO_SYMBOLICA;
 use crate::compile::simplify::{self, Limits};
 use crate::compile::{gradients, vertex::VertexModel};
 use crate::expr::{Counts, ExprGraph, Format, Names, NodeId, print::print};
@@ -269,9 +270,6 @@ fn render_symbolica(_: &FormulasArgs) -> Result<String> {
     bail!("{}", NO_SYMBOLICA)
 }
 
-/// The error of every Symbolica option in a build without the feature.
-pub const NO_SYMBOLICA: &str = "this foldsynth was built without Symbolica; rebuild with `cargo build --release --features symbolica`";
-
 /// Write `text` to `path` (saying so on stderr), or to standard output.
 pub fn emit(text: &str, path: Option<&Path>) -> Result<()> {
     match path {
@@ -350,49 +348,39 @@ fn kind_diff(more: &BTreeMap<&'static str, usize>, less: &BTreeMap<&'static str,
     }
 }
 
-/// The objective and constraint formulas of `model` (task `task`), with a header that says
-/// what every simplification stage removed.
-pub fn model_formulas(model: &Model, task: &str, opts: ModelFormulaOptions) -> Result<String> {
-    let (ctx, outputs) = symbolic(model);
-    let ids: Vec<NodeId> = outputs.iter().map(|o| ctx.node_id(o)).collect();
-    let graph = ctx.to_graph();
-    let mut out_names = vec!["objective".to_string()];
-    out_names.extend((1..ids.len()).map(|k| format!("g{k}")));
-    let n_modes = model.plan.internal.len();
-    let names = model_names(model);
-
-    let before = graph.counts(&ids);
-    let (simplified, s_ids, rep) = simplify::simplify(&graph, &ids, &Limits::default());
-    let after = simplified.counts(&s_ids);
-    let (mut g, mut outs) = if opts.simplify {
-        (simplified.clone(), s_ids.clone())
-    } else {
-        graph.extract(&ids)
-    };
-    let values = g.counts(&outs);
-    let mut printed: Vec<(String, NodeId)> = out_names.iter().cloned().zip(outs.clone()).collect();
-    let mut gradient_line = None;
-    if opts.gradient {
-        let grads = gradients(&mut g, &outs, model.free.len())?;
-        let mut zeros = 0;
-        for (k, grad) in grads.into_iter().enumerate() {
-            for (i, d) in grad.into_iter().enumerate() {
-                if g.const_value(d) == Some(0.0) {
-                    zeros += 1;
-                    continue;
-                }
-                printed.push((format!("d{}_d{}", out_names[k], names.vars[i]), d));
-                outs.push(d);
+/// Append the gradient of every printed output with respect to the free variables
+/// (`names`: the outputs' and the variables'), leaving out the partial derivatives that
+/// are identically 0; the header line that says so.
+fn add_gradients(
+    g: &mut ExprGraph,
+    outs: &mut Vec<NodeId>,
+    printed: &mut Vec<(String, NodeId)>,
+    n_vars: usize,
+    (out_names, var_names): (&[String], &[String]),
+) -> Result<String> {
+    let grads = gradients(g, outs, n_vars)?;
+    let mut zeros = 0;
+    for (k, grad) in grads.into_iter().enumerate() {
+        for (i, d) in grad.into_iter().enumerate() {
+            if g.const_value(d) == Some(0.0) {
+                zeros += 1;
+                continue;
             }
+            printed.push((format!("d{}_d{}", out_names[k], var_names[i]), d));
+            outs.push(d);
         }
-        let c = g.counts(&outs);
-        gradient_line = Some(format!(
-            "with the gradients (reverse mode on the printed graph): {} operations ({} calls); {zeros} partial derivatives that are identically 0 are left out",
-            c.ops, c.calls
-        ));
     }
+    let c = g.counts(outs);
+    Ok(format!(
+        "with the gradients (reverse mode on the printed graph): {} operations ({} calls); {zeros} partial derivatives that are identically 0 are left out",
+        c.ops, c.calls
+    ))
+}
 
-    let labels: Vec<String> = (0..ids.len() - 1)
+/// The header's first lines: the model, its variables, parameters and constraints.
+fn model_head(model: &Model, task: &str, names: &Names, n_constraints: usize) -> Vec<String> {
+    let n_modes = model.plan.internal.len();
+    let labels: Vec<String> = (0..n_constraints)
         .map(|k| format!("  g{} = {}", k + 1, model.constraint_label(k)))
         .collect();
     let times: Vec<String> = model
@@ -406,23 +394,13 @@ pub fn model_formulas(model: &Model, task: &str, opts: ModelFormulaOptions) -> R
             )
         })
         .collect();
-    let mut fired: Vec<String> = rep
-        .rules_fired
-        .iter()
-        .filter(|(r, _)| !r.starts_with("comm-"))
-        .map(|(r, n)| format!("{r} {n}"))
-        .collect();
-    if fired.is_empty() {
-        fired.push("none".to_string());
-    }
-    let (kb, ka) = (kinds(&graph, &ids), kinds(&simplified, &s_ids));
     let mut head = vec![
         format!(
             "model {} of task '{task}', gripping vertex v{} (candidate {}): objective and {} constraints g >= 0",
             model.plan.sequence,
             model.plan.vertices[model.gripping].name,
             model.candidate + 1,
-            ids.len() - 1
+            n_constraints
         ),
         format!("variables: {}", names.vars.join(", ")),
         format!(
@@ -433,16 +411,44 @@ pub fn model_formulas(model: &Model, task: &str, opts: ModelFormulaOptions) -> R
         "constraints:".to_string(),
     ];
     head.extend(labels);
-    head.extend([
+    head
+}
+
+/// Sizes of the model's graph at each stage.
+struct Stages {
+    /// As built.
+    before: Counts,
+    /// After egg.
+    after: Counts,
+    /// As printed (before or after egg, without gradients).
+    printed: Counts,
+    /// Operations by kind, as built.
+    kinds_before: BTreeMap<&'static str, usize>,
+    /// Operations by kind, after egg.
+    kinds_after: BTreeMap<&'static str, usize>,
+}
+
+/// The header's lines on what construction and egg removed, and what is printed.
+fn stage_lines(s: &Stages, rep: &simplify::Report, simplified: bool) -> [String; 7] {
+    let mut fired: Vec<String> = rep
+        .rules_fired
+        .iter()
+        .filter(|(r, _)| !r.starts_with("comm-"))
+        .map(|(r, n)| format!("{r} {n}"))
+        .collect();
+    if fired.is_empty() {
+        fired.push("none".to_string());
+    }
+    [
         format!(
             "as built: {} operations ({} calls); construction already folds constants and exact identities (x*1, x+0, -(-x), (-x)-y = -(x+y), x*0 and x-x where x is proven finite)",
-            before.ops, before.calls
+            s.before.ops, s.before.calls
         ),
         format!(
             "egg: {} operations ({} calls), {:.1}% fewer; {} e-nodes, {} iterations ({}), {:.1} ms",
-            after.ops,
-            after.calls,
-            pct(before.ops, after.ops),
+            s.after.ops,
+            s.after.calls,
+            pct(s.before.ops, s.after.ops),
             rep.egraph_nodes,
             rep.iterations,
             rep.stop_reason,
@@ -452,27 +458,76 @@ pub fn model_formulas(model: &Model, task: &str, opts: ModelFormulaOptions) -> R
             "  then {} zero terms (0*x, x-x) removed beside a term that is NaN wherever they are (x not provably finite)",
             rep.vanishing_terms
         ),
-        format!("  egg removed: {}", kind_diff(&kb, &ka)),
-        format!("  egg added: {}", kind_diff(&ka, &kb)),
+        format!(
+            "  egg removed: {}",
+            kind_diff(&s.kinds_before, &s.kinds_after)
+        ),
+        format!(
+            "  egg added: {}",
+            kind_diff(&s.kinds_after, &s.kinds_before)
+        ),
         format!(
             "  rules that fired (e-graph applications, commutativity left out): {}",
             fired.join(", ")
         ),
         format!(
             "printed: the graph {} ({} operations){}",
-            if opts.simplify {
+            if simplified {
                 "after egg"
             } else {
                 "as built (--no-simplify)"
             },
-            values.ops,
-            if opts.simplify {
+            s.printed.ops,
+            if simplified {
                 "; --no-simplify prints it as built"
             } else {
                 ""
             }
         ),
-    ]);
+    ]
+}
+
+/// The objective and constraint formulas of `model` (task `task`), with a header that says
+/// what every simplification stage removed.
+pub fn model_formulas(model: &Model, task: &str, opts: ModelFormulaOptions) -> Result<String> {
+    let (ctx, outputs) = symbolic(model);
+    let ids: Vec<NodeId> = outputs.iter().map(|o| ctx.node_id(o)).collect();
+    let graph = ctx.to_graph();
+    let mut out_names = vec!["objective".to_string()];
+    out_names.extend((1..ids.len()).map(|k| format!("g{k}")));
+    let names = model_names(model);
+
+    let before = graph.counts(&ids);
+    let (simplified, s_ids, rep) = simplify::simplify(&graph, &ids, &Limits::default());
+    let (mut g, mut outs) = if opts.simplify {
+        (simplified.clone(), s_ids.clone())
+    } else {
+        graph.extract(&ids)
+    };
+    let values = g.counts(&outs);
+    let mut printed: Vec<(String, NodeId)> = out_names.iter().cloned().zip(outs.clone()).collect();
+    let gradient_line = if opts.gradient {
+        let n_vars = model.free.len();
+        let named = (&out_names[..], &names.vars[..]);
+        Some(add_gradients(
+            &mut g,
+            &mut outs,
+            &mut printed,
+            n_vars,
+            named,
+        )?)
+    } else {
+        None
+    };
+    let stages = Stages {
+        before,
+        after: simplified.counts(&s_ids),
+        printed: values,
+        kinds_before: kinds(&graph, &ids),
+        kinds_after: kinds(&simplified, &s_ids),
+    };
+    let mut head = model_head(model, task, &names, ids.len() - 1);
+    head.extend(stage_lines(&stages, &rep, opts.simplify));
     head.extend(gradient_line);
     let body = print(&g, &printed, &names, opts.format);
     Ok(with_header(opts.format, &head, &body))

@@ -181,6 +181,34 @@ fn wait_until(child: &mut Child, deadline: Instant) -> Option<std::process::Exit
     }
 }
 
+/// Write every finding's input into the findings folder (`--findings`, else
+/// `out/fuzz`); the folder and the files written.
+fn save_findings(args: &FuzzArgs, findings: &[Finding]) -> Result<(PathBuf, Vec<PathBuf>)> {
+    let dir = args
+        .findings
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join("fuzz"));
+    let mut saved = Vec::new();
+    if !findings.is_empty() {
+        std::fs::create_dir_all(&dir)
+            .with_context(|| format!("cannot create {}", dir.display()))?;
+        for f in findings {
+            let path = dir.join(format!(
+                "{}-{}-{}-{}.{}",
+                f.target.name(),
+                f.kind,
+                args.seed,
+                f.index,
+                f.target.extension()
+            ));
+            std::fs::write(&path, fuzz::input(f.target, args.seed, f.index))
+                .with_context(|| format!("cannot write {}", path.display()))?;
+            saved.push(path);
+        }
+    }
+    Ok((dir, saved))
+}
+
 /// The parent: batches in child processes, findings collected and saved.
 fn parent(args: &FuzzArgs, targets: &[Target]) -> Result<()> {
     let t0 = Instant::now();
@@ -199,28 +227,7 @@ fn parent(args: &FuzzArgs, targets: &[Target]) -> Result<()> {
 
     let total: u64 = counts.values().map(|c| c.inputs).sum();
     let failing: Vec<&Finding> = findings.iter().filter(|f| f.kind != "slow").collect();
-    let dir = args
-        .findings
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join("fuzz"));
-    let mut saved = Vec::new();
-    if !findings.is_empty() {
-        std::fs::create_dir_all(&dir)
-            .with_context(|| format!("cannot create {}", dir.display()))?;
-        for f in &findings {
-            let path = dir.join(format!(
-                "{}-{}-{}-{}.{}",
-                f.target.name(),
-                f.kind,
-                args.seed,
-                f.index,
-                f.target.extension()
-            ));
-            std::fs::write(&path, fuzz::input(f.target, args.seed, f.index))
-                .with_context(|| format!("cannot write {}", path.display()))?;
-            saved.push(path);
-        }
-    }
+    let (dir, saved) = save_findings(args, &findings)?;
     let by_kind = |k: &str| findings.iter().filter(|f| f.kind == k).count();
     let report = json!({
         "seed": args.seed,

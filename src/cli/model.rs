@@ -2,7 +2,7 @@
 //! [--formulas FORMAT [--no-simplify] [--gradient] [--output FILE]] [--json]`: the
 //! optimization model of one graph, compiled, evaluated and verified.
 
-use crate::check::verify::{Tolerances, verify};
+use crate::check::verify::{Tolerances, VerifyReport, verify};
 use crate::compile::Options;
 use crate::expr::Format;
 use crate::grammar::{CreaseGraph, VarKind};
@@ -167,16 +167,7 @@ pub fn run(args: ModelArgs) -> Result<()> {
     let n = model.plan.internal.len();
     let modes = parse_modes(args.modes.as_deref(), n)?;
     if let Some(fmt) = &args.formulas {
-        let format: Format = fmt
-            .parse()
-            .map_err(|e| anyhow::anyhow!("--formulas: {e}"))?;
-        let opts = super::formulas::ModelFormulaOptions {
-            format,
-            simplify: !args.no_simplify,
-            gradient: args.gradient,
-        };
-        let text = super::formulas::model_formulas(&model, &task.name, opts)?;
-        return super::formulas::emit(&text, args.output.as_deref());
+        return print_formulas(&args, fmt, &model, &task.name);
     }
     let mut x = match &args.at {
         Some(p) => read_vars(&model, p)?,
@@ -184,120 +175,200 @@ pub fn run(args: ModelArgs) -> Result<()> {
     };
     let compiled = CompiledModel::new(&model, &Options::default())?;
     if args.optimize {
-        let problem = ModelProblem::new(&model, &compiled, &modes);
-        let opts = crate::optimize::Options {
-            starts: args.starts,
-            seed: args.seed,
-            target: Some(objective_target(&model)),
-            max_outer: if model.plan.sinks.is_empty() {
-                crate::optimize::Options::default().max_outer
-            } else {
-                crate::model::cycle::MAX_OUTER
-            },
-            ..Default::default()
-        };
-        let t0 = std::time::Instant::now();
-        let mut sol = crate::optimize::minimize(&problem, &opts);
-        // Cyclic patterns: Newton on the compatibility equations, to rounding.
-        crate::model::cycle::polish_solution(
-            &problem,
-            &model,
-            &modes,
-            &mut sol,
-            opts.feasibility_tol,
-            opts.target,
-        );
-        eprintln!(
-            "optimized in {:.1} ms: {} starts, {} evaluations, feasible {}, target met {}",
-            t0.elapsed().as_secs_f64() * 1e3,
-            sol.starts_run,
-            sol.evaluations,
-            sol.feasible,
-            sol.met_target
-        );
-        x = sol.x;
+        x = optimize(&args, &model, &compiled, &modes);
     }
-    let params = compiled.params(&model, &modes);
-    let mut buf = vec![0.0; compiled.buffer_len()];
-    compiled.call(&x, &params, &mut buf);
-    let full = model.full_vars(&x);
-    let omega = model.omega(&full, &modes);
-    let design = Evaluated::new(&model.plan, full.clone(), modes.clone());
-    let report = verify(
-        &design,
-        &sample_times(model.t_max, args.sweep.max(2)),
-        &Tolerances::default(),
-    );
-    // A cyclic pattern (r2′): the compatibility sweep and the bar-and-hinge simulation.
-    let cycle = (!model.plan.sinks.is_empty()).then(|| {
-        verify_cyclic(
-            &model,
-            &full,
-            &modes,
-            args.sweep.max(2),
-            Tolerances::default().geometry_margin,
-        )
-    });
+    let e = Evaluation::new(&model, &compiled, x, modes, args.sweep);
     if let Some(path) = &args.save {
-        save_design(
-            path,
-            &task,
-            &model,
-            &x,
-            &modes,
-            omega,
-            &report,
-            cycle.as_ref(),
-        )?;
+        save_design(path, &task, &model, &e)?;
     }
-    let rep = &compiled.compiled.report;
-    let layout = &compiled.compiled.layout;
-    let constraint_values: Vec<f64> = (0..compiled.n_constraints)
-        .map(|k| buf[layout.value(k + 1)])
-        .collect();
-    let gripping = model.plan.vertices[model.gripping].name;
-
     if args.json {
-        let variables: Vec<_> = model
-            .free
-            .iter()
-            .enumerate()
-            .map(|(k, &i)| {
-                let v = &model.plan.variables[i];
-                let (lo, hi) = model.var_bounds(i);
-                json!({"name": v.name, "kind": kind(v.kind), "lower": lo, "upper": hi, "value": x[k]})
-            })
-            .collect();
-        let constraints: Vec<_> = (0..compiled.n_constraints)
-            .map(|k| json!({"label": model.constraint_label(k), "value": constraint_values[k]}))
-            .collect();
-        let out = json!({
-            "task": task.name,
-            "graph": model.plan.sequence,
-            "internal_vertices": n,
-            "modes": modes.iter().map(|m| if *m > 0.0 { "up" } else { "down" }).collect::<Vec<_>>(),
-            "candidate": args.candidate,
-            "gripping_vertex": gripping,
-            "variables": variables,
-            "dropped": model.plan.variables.iter().enumerate().filter(|(i, _)| !model.free.contains(i)).map(|(_, v)| &v.name).collect::<Vec<_>>(),
-            "constraints": constraints,
-            "objective": omega,
-            "objective_compiled": buf[layout.value(0)],
-            "meets_target": omega <= model.threshold && constraint_values.iter().all(|g| *g >= -1e-9),
-            "threshold": model.threshold,
-            "counts": {"before": rep.input, "after": rep.simplified, "with_gradient": rep.with_gradients},
-            "build_ms": compiled.build_ms,
-            "compile_ms": compiled.total_ms,
-            "verification": report,
-        });
-        let mut out = out;
-        if let Some(c) = &cycle {
-            out["cycle"] = json!(c);
-        }
+        let out = model_json(&args, &task, &model, &compiled, &e);
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
+    print_model(&args, &task, &model, &compiled, &e);
+    if let Some(path) = &args.save {
+        println!("\ndesign written to {}", path.display());
+    }
+    Ok(())
+}
 
+/// `--formulas`: the objective and constraint formulas instead of an evaluation.
+fn print_formulas(args: &ModelArgs, fmt: &str, model: &Model, task: &str) -> Result<()> {
+    let format: Format = fmt
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--formulas: {e}"))?;
+    let opts = super::formulas::ModelFormulaOptions {
+        format,
+        simplify: !args.no_simplify,
+        gradient: args.gradient,
+    };
+    let text = super::formulas::model_formulas(model, task, opts)?;
+    super::formulas::emit(&text, args.output.as_deref())
+}
+
+/// `--optimize`: the optimized free variables (reported on stderr).
+fn optimize(args: &ModelArgs, model: &Model, compiled: &CompiledModel, modes: &[f64]) -> Vec<f64> {
+    let problem = ModelProblem::new(model, compiled, modes);
+    let opts = crate::optimize::Options {
+        starts: args.starts,
+        seed: args.seed,
+        target: Some(objective_target(model)),
+        max_outer: if model.plan.sinks.is_empty() {
+            crate::optimize::Options::default().max_outer
+        } else {
+            crate::model::cycle::MAX_OUTER
+        },
+        ..Default::default()
+    };
+    let t0 = std::time::Instant::now();
+    let mut sol = crate::optimize::minimize(&problem, &opts);
+    // Cyclic patterns: Newton on the compatibility equations, to rounding.
+    crate::model::cycle::polish_solution(
+        &problem,
+        model,
+        modes,
+        &mut sol,
+        opts.feasibility_tol,
+        opts.target,
+    );
+    eprintln!(
+        "optimized in {:.1} ms: {} starts, {} evaluations, feasible {}, target met {}",
+        t0.elapsed().as_secs_f64() * 1e3,
+        sol.starts_run,
+        sol.evaluations,
+        sol.feasible,
+        sol.met_target
+    );
+    sol.x
+}
+
+/// The model evaluated and verified at one point.
+struct Evaluation {
+    /// The free variables.
+    x: Vec<f64>,
+    /// The modes.
+    modes: Vec<f64>,
+    /// The compiled function's output buffer at `x`.
+    buf: Vec<f64>,
+    /// The objective Ω by the f64 model.
+    omega: f64,
+    /// The verification sweep.
+    report: VerifyReport,
+    /// A cyclic pattern's verdict.
+    cycle: Option<CyclicVerdict>,
+    /// ψ at `x`.
+    constraint_values: Vec<f64>,
+}
+
+impl Evaluation {
+    fn new(
+        model: &Model,
+        compiled: &CompiledModel,
+        x: Vec<f64>,
+        modes: Vec<f64>,
+        sweep: usize,
+    ) -> Evaluation {
+        let params = compiled.params(model, &modes);
+        let mut buf = vec![0.0; compiled.buffer_len()];
+        compiled.call(&x, &params, &mut buf);
+        let full = model.full_vars(&x);
+        let omega = model.omega(&full, &modes);
+        let design = Evaluated::new(&model.plan, full.clone(), modes.clone());
+        let report = verify(
+            &design,
+            &sample_times(model.t_max, sweep.max(2)),
+            &Tolerances::default(),
+        );
+        // A cyclic pattern (r2′): the compatibility sweep and the bar-and-hinge simulation.
+        let cycle = (!model.plan.sinks.is_empty()).then(|| {
+            verify_cyclic(
+                model,
+                &full,
+                &modes,
+                sweep.max(2),
+                Tolerances::default().geometry_margin,
+            )
+        });
+        let layout = &compiled.compiled.layout;
+        let constraint_values: Vec<f64> = (0..compiled.n_constraints)
+            .map(|k| buf[layout.value(k + 1)])
+            .collect();
+        Evaluation {
+            x,
+            modes,
+            buf,
+            omega,
+            report,
+            cycle,
+            constraint_values,
+        }
+    }
+}
+
+/// "up" or "down".
+fn mode_name(m: f64) -> &'static str {
+    if m > 0.0 { "up" } else { "down" }
+}
+
+/// `--json`: the model, the point and its verification.
+fn model_json(
+    args: &ModelArgs,
+    task: &Task,
+    model: &Model,
+    compiled: &CompiledModel,
+    e: &Evaluation,
+) -> serde_json::Value {
+    let rep = &compiled.compiled.report;
+    let layout = &compiled.compiled.layout;
+    let variables: Vec<_> = model
+        .free
+        .iter()
+        .enumerate()
+        .map(|(k, &i)| {
+            let v = &model.plan.variables[i];
+            let (lo, hi) = model.var_bounds(i);
+            json!({"name": v.name, "kind": kind(v.kind), "lower": lo, "upper": hi, "value": e.x[k]})
+        })
+        .collect();
+    let constraints: Vec<_> = (0..compiled.n_constraints)
+        .map(|k| json!({"label": model.constraint_label(k), "value": e.constraint_values[k]}))
+        .collect();
+    let mut out = json!({
+        "task": task.name,
+        "graph": model.plan.sequence,
+        "internal_vertices": model.plan.internal.len(),
+        "modes": e.modes.iter().map(|m| mode_name(*m)).collect::<Vec<_>>(),
+        "candidate": args.candidate,
+        "gripping_vertex": model.plan.vertices[model.gripping].name,
+        "variables": variables,
+        "dropped": model.plan.variables.iter().enumerate().filter(|(i, _)| !model.free.contains(i)).map(|(_, v)| &v.name).collect::<Vec<_>>(),
+        "constraints": constraints,
+        "objective": e.omega,
+        "objective_compiled": e.buf[layout.value(0)],
+        "meets_target": e.omega <= model.threshold && e.constraint_values.iter().all(|g| *g >= -1e-9),
+        "threshold": model.threshold,
+        "counts": {"before": rep.input, "after": rep.simplified, "with_gradient": rep.with_gradients},
+        "build_ms": compiled.build_ms,
+        "compile_ms": compiled.total_ms,
+        "verification": e.report,
+    });
+    if let Some(c) = &e.cycle {
+        out["cycle"] = json!(c);
+    }
+    out
+}
+
+/// The text report: the model, its variables and constraints at the point, the compiled
+/// graph, the objective and the verification.
+fn print_model(
+    args: &ModelArgs,
+    task: &Task,
+    model: &Model,
+    compiled: &CompiledModel,
+    e: &Evaluation,
+) {
+    let gripping = model.plan.vertices[model.gripping].name;
     println!(
         "model of {} for task '{}', gripping vertex v{gripping} (candidate {})",
         model.plan.sequence, task.name, args.candidate
@@ -311,12 +382,46 @@ pub fn run(args: ModelArgs) -> Result<()> {
             .map(|v| format!("v{}", model.plan.vertices[*v].name))
             .collect::<Vec<_>>()
             .join(", "),
-        modes
+        e.modes
             .iter()
-            .map(|m| if *m > 0.0 { "up" } else { "down" })
+            .map(|m| mode_name(*m))
             .collect::<Vec<_>>()
             .join(", ")
     );
+    print_variables(model, &e.x);
+    println!("\nconstraints ψ (g ≥ 0), value at this point:");
+    for (k, g) in e.constraint_values.iter().enumerate() {
+        println!(
+            "  {:>12.6}{}  {}",
+            g,
+            if *g < -1e-9 { " ✗" } else { "  " },
+            model.constraint_label(k)
+        );
+    }
+    let rep = &compiled.compiled.report;
+    println!(
+        "\nexpression graph: {} operations as built, {} after egg, {} with all gradients; build {:.2} ms, build→native {:.2} ms",
+        rep.input.ops,
+        rep.simplified.ops,
+        rep.with_gradients.ops,
+        compiled.build_ms,
+        compiled.total_ms
+    );
+    println!(
+        "objective Ω = {:.6e} (threshold {:.1e}; compiled objective {:.6e}, target {:.3e})",
+        e.omega,
+        model.threshold,
+        e.buf[compiled.compiled.layout.value(0)],
+        objective_target(model)
+    );
+    print_verification(&e.report, model.t_max);
+    if let Some(c) = &e.cycle {
+        print_cycle(c, model.t_max);
+    }
+}
+
+/// The free variables with their bounds and values, and the dropped ones.
+fn print_variables(model: &Model, x: &[f64]) {
     println!("\nvariables (Φ_opt):");
     for (k, &i) in model.free.iter().enumerate() {
         let v = &model.plan.variables[i];
@@ -342,32 +447,13 @@ pub fn run(args: ModelArgs) -> Result<()> {
             dropped.join(", ")
         );
     }
-    println!("\nconstraints ψ (g ≥ 0), value at this point:");
-    for (k, g) in constraint_values.iter().enumerate() {
-        println!(
-            "  {:>12.6}{}  {}",
-            g,
-            if *g < -1e-9 { " ✗" } else { "  " },
-            model.constraint_label(k)
-        );
-    }
-    println!(
-        "\nexpression graph: {} operations as built, {} after egg, {} with all gradients; build {:.2} ms, build→native {:.2} ms",
-        rep.input.ops,
-        rep.simplified.ops,
-        rep.with_gradients.ops,
-        compiled.build_ms,
-        compiled.total_ms
-    );
-    println!(
-        "objective Ω = {omega:.6e} (threshold {:.1e}; compiled objective {:.6e}, target {:.3e})",
-        model.threshold,
-        buf[layout.value(0)],
-        objective_target(&model)
-    );
+}
+
+/// The verification sweep's figures.
+fn print_verification(report: &VerifyReport, t_max: f64) {
     println!(
         "\nverification over {} states in [0, {:.6}]:",
-        report.states, model.t_max
+        report.states, t_max
     );
     println!("  isometry max          {:.3e}", report.isometry_max);
     println!("  closure max           {:.3e}", report.closure_max);
@@ -377,13 +463,6 @@ pub fn run(args: ModelArgs) -> Result<()> {
         "  rigid over the motion {}  (at t_max: {}; smallest margin {:.3e} at t = {:.6})",
         report.rigid_over_motion, report.rigid_at_tmax, report.min_margin, report.min_margin_t
     );
-    if let Some(c) = &cycle {
-        print_cycle(c, model.t_max);
-    }
-    if let Some(path) = &args.save {
-        println!("\ndesign written to {}", path.display());
-    }
-    Ok(())
 }
 
 /// The verdict on a cyclic design, in words.
@@ -442,25 +521,13 @@ fn print_cycle(c: &CyclicVerdict, t_max: f64) {
 }
 
 /// Write a design file (see [`ModelArgs::save`]).
-#[allow(clippy::too_many_arguments)]
-fn save_design(
-    path: &Path,
-    task: &Task,
-    model: &Model,
-    x: &[f64],
-    modes: &[f64],
-    omega: f64,
-    report: &crate::check::verify::VerifyReport,
-    cycle: Option<&CyclicVerdict>,
-) -> Result<()> {
-    let names: Vec<String> = modes
-        .iter()
-        .map(|m| if *m > 0.0 { "up" } else { "down" }.to_string())
-        .collect();
+fn save_design(path: &Path, task: &Task, model: &Model, e: &Evaluation) -> Result<()> {
+    let (x, modes) = (&e.x, &e.modes);
+    let names: Vec<String> = modes.iter().map(|m| mode_name(*m).to_string()).collect();
     let full = model.full_vars(x);
     let design = Evaluated::new(&model.plan, full.clone(), modes.to_vec());
     let pattern = design.pattern(&sample_times(model.t_max, 33));
-    let mut meta = crate::search::model_meta(task, model, &names, omega);
+    let mut meta = crate::search::model_meta(task, model, &names, e.omega);
     meta.extra
         .insert("candidate".into(), json!(model.candidate + 1));
     let variables: std::collections::BTreeMap<&str, f64> = model
@@ -482,12 +549,12 @@ fn save_design(
         "candidate": model.candidate + 1,
         "gripping_vertex": model.plan.vertices[model.gripping].name,
         "modes": names,
-        "objective": omega,
+        "objective": e.omega,
         "threshold": model.threshold,
         "variables": variables,
         "all_variables": all,
-        "verification": report,
-        "cycle": cycle,
+        "verification": e.report,
+        "cycle": e.cycle,
         "pattern": pattern,
         "meta": meta,
     });

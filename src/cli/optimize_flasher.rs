@@ -73,72 +73,8 @@ pub fn run(args: OptimizeFlasherArgs) -> anyhow::Result<()> {
         settings.factor,
         settings.inner
     );
-    let _ = writeln!(
-        o,
-        "{:<28} {:>12} {:>12} {:>12}",
-        "", "this run", "thesis", "thesis design here"
-    );
-    let row = |o: &mut String, name: &str, a: String, b: &str, c: String| {
-        let _ = writeln!(o, "{name:<28} {a:>12} {b:>12} {c:>12}");
-    };
     let e = &result.best;
-    let d = &thesis_design;
-    row(
-        &mut o,
-        "best objective",
-        format!("{:.4}", e.objective),
-        "-0.88",
-        format!("{:.4}", d.objective),
-    );
-    row(
-        &mut o,
-        "projected area A",
-        format!("{:.3}", e.area),
-        "44.0",
-        format!("{:.3}", d.area),
-    );
-    row(
-        &mut o,
-        "rigidity error Gamma",
-        format!("{:.2e}", e.gamma),
-        "1.6e-6",
-        format!("{:.2e}", d.gamma),
-    );
-    row(
-        &mut o,
-        "max delta(j)",
-        format!("{:.2e}", e.max_delta),
-        "<= 1e-4",
-        format!("{:.2e}", d.max_delta),
-    );
-    row(
-        &mut o,
-        "self-intersection theta",
-        format!("{:.4}", e.theta),
-        "0",
-        format!("{:.4}", d.theta),
-    );
-    row(
-        &mut o,
-        "spatial feasibility Omega",
-        format!("{:.4}", e.omega),
-        "0",
-        format!("{:.4}", d.omega),
-    );
-    row(
-        &mut o,
-        "feasible",
-        e.feasible.to_string(),
-        "true",
-        d.feasible.to_string(),
-    );
-    row(
-        &mut o,
-        "wall time",
-        format!("{seconds:.1} s"),
-        "8.5 h",
-        String::new(),
-    );
+    comparison(&mut o, e, &thesis_design, seconds);
     design(&mut o, "best design", e);
     match &result.best_feasible {
         Some(f) if f != e => {
@@ -157,6 +93,68 @@ pub fn run(args: OptimizeFlasherArgs) -> anyhow::Result<()> {
     super::simulate::emit(&o)
 }
 
+/// This run's best design, the thesis's figures and the thesis's design evaluated here,
+/// side by side.
+fn comparison(o: &mut String, e: &FlasherEvaluation, d: &FlasherEvaluation, seconds: f64) {
+    let _ = writeln!(
+        o,
+        "{:<28} {:>12} {:>12} {:>12}",
+        "", "this run", "thesis", "thesis design here"
+    );
+    let mut row = |name: &str, a: String, b: &str, c: String| {
+        let _ = writeln!(o, "{name:<28} {a:>12} {b:>12} {c:>12}");
+    };
+    row(
+        "best objective",
+        format!("{:.4}", e.objective),
+        "-0.88",
+        format!("{:.4}", d.objective),
+    );
+    row(
+        "projected area A",
+        format!("{:.3}", e.area),
+        "44.0",
+        format!("{:.3}", d.area),
+    );
+    row(
+        "rigidity error Gamma",
+        format!("{:.2e}", e.gamma),
+        "1.6e-6",
+        format!("{:.2e}", d.gamma),
+    );
+    row(
+        "max delta(j)",
+        format!("{:.2e}", e.max_delta),
+        "<= 1e-4",
+        format!("{:.2e}", d.max_delta),
+    );
+    row(
+        "self-intersection theta",
+        format!("{:.4}", e.theta),
+        "0",
+        format!("{:.4}", d.theta),
+    );
+    row(
+        "spatial feasibility Omega",
+        format!("{:.4}", e.omega),
+        "0",
+        format!("{:.4}", d.omega),
+    );
+    row(
+        "feasible",
+        e.feasible.to_string(),
+        "true",
+        d.feasible.to_string(),
+    );
+    row(
+        "wall time",
+        format!("{seconds:.1} s"),
+        "8.5 h",
+        String::new(),
+    );
+}
+
+/// A design's positions x3, x4, x5 and its Eq. 5 variables.
 fn design(o: &mut String, title: &str, e: &FlasherEvaluation) {
     let _ = writeln!(o, "{title}:");
     for (k, name) in ["x3", "x4", "x5"].iter().enumerate() {

@@ -261,14 +261,13 @@ fn parse_t_max(src: &str) -> anyhow::Result<f64> {
     Ok(x)
 }
 
-fn run_pattern(
+/// The cross-validation settings for a FOLD/design pattern from the flags: the end of
+/// the motion (`--t-max`, else the frames') and the steps.
+fn pattern_options(
     path: &Path,
-    name: &str,
     pattern: &Pattern,
-    note: Option<String>,
     args: &SimulateArgs,
-) -> anyhow::Result<()> {
-    let drive = drive_for(pattern, args).with_context(|| path.display().to_string())?;
+) -> anyhow::Result<CrossvalOptions> {
     let t_end = match &args.t_max {
         Some(s) => Some(parse_t_max(s)?),
         None if pattern.frames.len() < 2 => {
@@ -284,13 +283,24 @@ fn run_pattern(
         None if pattern.frames.len() < 2 => Some(30),
         None => None,
     };
-    let opts = CrossvalOptions {
+    Ok(CrossvalOptions {
         steps,
         t_end,
         check_intersections: !args.no_intersections,
         rigid_panels: !args.eq2_bars,
         ..Default::default()
-    };
+    })
+}
+
+fn run_pattern(
+    path: &Path,
+    name: &str,
+    pattern: &Pattern,
+    note: Option<String>,
+    args: &SimulateArgs,
+) -> anyhow::Result<()> {
+    let drive = drive_for(pattern, args).with_context(|| path.display().to_string())?;
+    let opts = pattern_options(path, pattern, args)?;
     let start = Instant::now();
     let r = crossval::crossval(pattern, &drive, &opts)
         .with_context(|| format!("simulating {}", path.display()))?;
@@ -329,6 +339,21 @@ fn run_pattern(
         return verdict();
     }
     let mut o = String::new();
+    pattern_text(&mut o, name, pattern, &drive, &r, note.as_deref());
+    let _ = writeln!(o, "time                {seconds:.3} s");
+    emit(&o)?;
+    verdict()
+}
+
+/// The text report of one FOLD/design simulation, compared with its frames.
+fn pattern_text(
+    o: &mut String,
+    name: &str,
+    pattern: &Pattern,
+    drive: &G0Drive,
+    r: &CrossvalReport,
+    note: Option<&str>,
+) {
     let [p, q] = pattern.edges[drive.edge].v;
     let _ = writeln!(o, "{name}");
     let _ = writeln!(
@@ -344,11 +369,11 @@ fn run_pattern(
         r.t_start,
         r.t_end
     );
-    if let Some(n) = &note {
+    if let Some(n) = note {
         let _ = writeln!(o, "note: {n}");
     }
-    steps_table(&mut o, &r.sim, Some(&r));
-    summary(&mut o, &r.sim);
+    steps_table(o, &r.sim, Some(r));
+    summary(o, &r.sim);
     if r.compared_states > 0 {
         let _ = writeln!(
             o,
@@ -371,10 +396,7 @@ fn run_pattern(
         );
     }
     let names: Vec<String> = (0..pattern.vertices.len()).map(|i| i.to_string()).collect();
-    positions(&mut o, &names, r.sim.final_positions());
-    let _ = writeln!(o, "time                {seconds:.3} s");
-    emit(&o)?;
-    verdict()
+    positions(o, &names, r.sim.final_positions());
 }
 
 /// One design of a `--crossval` run.
@@ -416,8 +438,30 @@ fn run_crossval(dir: &Path, args: &SimulateArgs) -> anyhow::Result<()> {
         rigid_panels: !args.eq2_bars,
         ..Default::default()
     };
-    // One design per task on the rayon pool (`collect` keeps the files' order).
-    let rows: Vec<Row> = files
+    let rows = crossval_rows(&files, &opts);
+    let seconds = start.elapsed().as_secs_f64();
+    let totals = Totals::new(&rows);
+    let failed = rows.len() - totals.passed;
+    if args.json {
+        let out = crossval_json(&rows, &totals, seconds);
+        emit(&(serde_json::to_string_pretty(&out)? + "\n"))?;
+    } else {
+        emit(&crossval_text(&rows, &totals, seconds))?;
+    }
+    if failed > 0 {
+        return Err(super::CheckFailed(format!(
+            "{failed} of {} designs do not agree with the PTU",
+            rows.len()
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+/// Every design simulated and compared: one design per task on the rayon pool
+/// (`collect` keeps the files' order).
+fn crossval_rows(files: &[PathBuf], opts: &CrossvalOptions) -> Vec<Row> {
+    files
         .par_iter()
         .map(|path| match read_design(path) {
             Err(e) => Row {
@@ -428,7 +472,7 @@ fn run_crossval(dir: &Path, args: &SimulateArgs) -> anyhow::Result<()> {
             Ok((name, pattern)) => {
                 let result = G0Drive::marked_edge(&pattern)
                     .and_then(|e| G0Drive::from_frames(&pattern, e))
-                    .and_then(|d| crossval::crossval(&pattern, &d, &opts))
+                    .and_then(|d| crossval::crossval(&pattern, &d, opts))
                     .map_err(|e| e.to_string());
                 Row {
                     name,
@@ -437,111 +481,127 @@ fn run_crossval(dir: &Path, args: &SimulateArgs) -> anyhow::Result<()> {
                 }
             }
         })
+        .collect()
+}
+
+/// Whether a design agrees with the PTU.
+fn pass(r: &CrossvalReport) -> bool {
+    r.agrees(GAMMA_TOL, POSITION_TOL)
+}
+
+/// The worst figures over the designs that ran, and how many agree.
+struct Totals {
+    passed: usize,
+    max_gamma: f64,
+    max_delta: f64,
+    max_err: f64,
+    max_drive: f64,
+    max_final: f64,
+    max_theta: f64,
+}
+
+impl Totals {
+    fn new(rows: &[Row]) -> Totals {
+        let ok: Vec<&CrossvalReport> = rows.iter().filter_map(|r| r.result.as_ref().ok()).collect();
+        let max = |f: &dyn Fn(&CrossvalReport) -> f64| ok.iter().map(|r| f(r)).fold(0.0, f64::max);
+        Totals {
+            passed: ok.iter().filter(|r| pass(r)).count(),
+            max_gamma: max(&|r| r.gamma),
+            max_delta: max(&|r| r.max_delta),
+            max_err: max(&|r| r.max_position_error),
+            max_drive: max(&|r| r.drive_error),
+            max_final: max(&|r| r.final_position_error.unwrap_or(f64::INFINITY)),
+            max_theta: max(&|r| r.theta),
+        }
+    }
+}
+
+/// `--crossval --json`.
+fn crossval_json(rows: &[Row], t: &Totals, seconds: f64) -> serde_json::Value {
+    let designs: Vec<_> = rows
+        .iter()
+        .map(|row| match &row.result {
+            Ok(r) => json!({
+                "design": row.name,
+                "vertices": row.vertices,
+                "free_vertices": r.free_vertices,
+                "steps": r.steps,
+                "compared_states": r.compared_states,
+                "gamma": r.gamma,
+                "max_delta": r.max_delta,
+                "rigid": r.rigid,
+                "theta": r.theta,
+                "max_position_error": r.max_position_error,
+                "final_position_error": r.final_position_error,
+                "drive_error": r.drive_error,
+                "widened_states": r.widened_states,
+                "start_gap": r.start_gap,
+                "agrees": pass(r),
+            }),
+            Err(e) => json!({"design": row.name, "error": e, "agrees": false}),
+        })
         .collect();
-    let seconds = start.elapsed().as_secs_f64();
-    let ok: Vec<&CrossvalReport> = rows.iter().filter_map(|r| r.result.as_ref().ok()).collect();
-    let pass = |r: &CrossvalReport| r.agrees(GAMMA_TOL, POSITION_TOL);
-    let passed = ok.iter().filter(|r| pass(r)).count();
-    let max = |f: &dyn Fn(&CrossvalReport) -> f64| ok.iter().map(|r| f(r)).fold(0.0, f64::max);
-    let (max_gamma, max_delta, max_err, max_drive) = (
-        max(&|r| r.gamma),
-        max(&|r| r.max_delta),
-        max(&|r| r.max_position_error),
-        max(&|r| r.drive_error),
+    json!({
+        "designs": designs,
+        "count": rows.len(),
+        "agree": t.passed,
+        "max_gamma": t.max_gamma,
+        "max_delta": t.max_delta,
+        "max_position_error": t.max_err,
+        "max_final_position_error": t.max_final,
+        "max_drive_error": t.max_drive,
+        "max_theta": t.max_theta,
+        "gamma_tol": GAMMA_TOL,
+        "position_tol": POSITION_TOL,
+        "seconds": seconds,
+    })
+}
+
+/// `--crossval`: a table of the designs and the totals.
+fn crossval_text(rows: &[Row], t: &Totals, seconds: f64) -> String {
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "{:<14} {:>3} {:>4} {:>3} {:>10} {:>10} {:>10} {:>10} {:>6}  agrees",
+        "design", "n", "free", "J", "Gamma", "max delta", "max |x-X|", "final", "theta"
     );
-    let max_final = max(&|r| r.final_position_error.unwrap_or(f64::INFINITY));
-    let max_theta = max(&|r| r.theta);
-    let failed = rows.len() - passed;
-    if args.json {
-        let designs: Vec<_> = rows
-            .iter()
-            .map(|row| match &row.result {
-                Ok(r) => json!({
-                    "design": row.name,
-                    "vertices": row.vertices,
-                    "free_vertices": r.free_vertices,
-                    "steps": r.steps,
-                    "compared_states": r.compared_states,
-                    "gamma": r.gamma,
-                    "max_delta": r.max_delta,
-                    "rigid": r.rigid,
-                    "theta": r.theta,
-                    "max_position_error": r.max_position_error,
-                    "final_position_error": r.final_position_error,
-                    "drive_error": r.drive_error,
-                    "widened_states": r.widened_states,
-                    "start_gap": r.start_gap,
-                    "agrees": pass(r),
-                }),
-                Err(e) => json!({"design": row.name, "error": e, "agrees": false}),
-            })
-            .collect();
-        let out = json!({
-            "designs": designs,
-            "count": rows.len(),
-            "agree": passed,
-            "max_gamma": max_gamma,
-            "max_delta": max_delta,
-            "max_position_error": max_err,
-            "max_final_position_error": max_final,
-            "max_drive_error": max_drive,
-            "max_theta": max_theta,
-            "gamma_tol": GAMMA_TOL,
-            "position_tol": POSITION_TOL,
-            "seconds": seconds,
-        });
-        emit(&(serde_json::to_string_pretty(&out)? + "\n"))?;
-    } else {
-        let mut o = String::new();
-        let _ = writeln!(
-            o,
-            "{:<14} {:>3} {:>4} {:>3} {:>10} {:>10} {:>10} {:>10} {:>6}  agrees",
-            "design", "n", "free", "J", "Gamma", "max delta", "max |x-X|", "final", "theta"
-        );
-        for row in &rows {
-            match &row.result {
-                Ok(r) => {
-                    let _ = writeln!(
-                        o,
-                        "{:<14} {:>3} {:>4} {:>3} {:>10.2e} {:>10.2e} {:>10.2e} {:>10} {:>6.3}  {}",
-                        row.name,
-                        row.vertices,
-                        r.free_vertices,
-                        r.steps,
-                        r.gamma,
-                        r.max_delta,
-                        r.max_position_error,
-                        r.final_position_error
-                            .map_or("-".into(), |e| format!("{e:.2e}")),
-                        r.theta,
-                        if pass(r) { "yes" } else { "NO" }
-                    );
-                }
-                Err(e) => {
-                    let _ = writeln!(o, "{:<14} error: {e}", row.name);
-                }
+    for row in rows {
+        match &row.result {
+            Ok(r) => {
+                let _ = writeln!(
+                    o,
+                    "{:<14} {:>3} {:>4} {:>3} {:>10.2e} {:>10.2e} {:>10.2e} {:>10} {:>6.3}  {}",
+                    row.name,
+                    row.vertices,
+                    r.free_vertices,
+                    r.steps,
+                    r.gamma,
+                    r.max_delta,
+                    r.max_position_error,
+                    r.final_position_error
+                        .map_or("-".into(), |e| format!("{e:.2e}")),
+                    r.theta,
+                    if pass(r) { "yes" } else { "NO" }
+                );
+            }
+            Err(e) => {
+                let _ = writeln!(o, "{:<14} error: {e}", row.name);
             }
         }
-        let _ = writeln!(
-            o,
-            "{} designs, {passed} agree with the PTU (Γ <= {GAMMA_TOL:e}, |x - X| <= {POSITION_TOL:e} at every compared state)",
-            rows.len()
-        );
-        let _ = writeln!(
-            o,
-            "max Γ {max_gamma:.3e}, max δ(j) {max_delta:.3e}, max |x - X| {max_err:.3e} (final state {max_final:.3e}), prescribed vertices {max_drive:.3e}, max θ {max_theta:.3}"
-        );
-        let _ = writeln!(o, "time {seconds:.2} s");
-        emit(&o)?;
     }
-    if failed > 0 {
-        return Err(super::CheckFailed(format!(
-            "{failed} of {} designs do not agree with the PTU",
-            rows.len()
-        ))
-        .into());
-    }
-    Ok(())
+    let _ = writeln!(
+        o,
+        "{} designs, {} agree with the PTU (Γ <= {GAMMA_TOL:e}, |x - X| <= {POSITION_TOL:e} at every compared state)",
+        rows.len(),
+        t.passed
+    );
+    let _ = writeln!(
+        o,
+        "max Γ {:.3e}, max δ(j) {:.3e}, max |x - X| {:.3e} (final state {:.3e}), prescribed vertices {:.3e}, max θ {:.3}",
+        t.max_gamma, t.max_delta, t.max_err, t.max_final, t.max_drive, t.max_theta
+    );
+    let _ = writeln!(o, "time {seconds:.2} s");
+    o
 }
 
 /// Write to stdout; a closed pipe (`| head`) ends the output quietly instead of failing.

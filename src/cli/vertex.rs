@@ -88,93 +88,173 @@ struct Sample {
     closure: f64,
 }
 
+/// The PTU at `t`: the state (φ wrapped), rigidity and closure residual.
+fn sample(spec: &VertexSpec, mode: &f64, t: f64) -> Sample {
+    let units = spec.units_at(t);
+    let mut state = solve_vertex(&units, mode);
+    // φ can carry full turns (Sec. 4.4); report the fold angle in (−π, π].
+    state.phi = state.phi.map(crate::kinematics::wrap_angle);
+    let margin = state.margins.iter().copied().fold(f64::INFINITY, f64::min);
+    let rigid = margin >= -RIGID_TOL;
+    let closure = closure_residual(&units, &state.phi);
+    Sample {
+        t,
+        state,
+        rigid,
+        closure,
+    }
+}
+
+/// What the vertex is, over the samples.
+struct Summary {
+    samples: Vec<Sample>,
+    intervals: Vec<[f64; 2]>,
+    flat: bool,
+    u_pi: [f64; 3],
+    closure_max: f64,
+    d4: Option<foldability::Degree4>,
+    sector_sum: f64,
+    developable: bool,
+}
+
+impl Summary {
+    fn new(spec: &VertexSpec, ts: &[f64]) -> Summary {
+        let mode = spec.mode.sign();
+        let samples: Vec<Sample> = ts.iter().map(|&t| sample(spec, &mode, t)).collect();
+        let intervals = if ts.len() > 1 {
+            foldability::rigid_intervals(ts, 1e-11, |t| foldability::min_margin(spec, t))
+        } else {
+            samples
+                .iter()
+                .filter(|s| s.rigid)
+                .map(|s| [s.t, s.t])
+                .collect()
+        };
+        let (flat, u_pi) = flat_foldable(&spec.units_at(0.0), 1e-9);
+        let closure_max = samples
+            .iter()
+            .filter(|s| s.rigid)
+            .map(|s| s.closure)
+            .fold(0.0, f64::max);
+        let d4 = foldability::degree4(spec);
+        let sector_sum: f64 = spec.sectors_rad().iter().sum();
+        let developable = (sector_sum - 2.0 * std::f64::consts::PI).abs() < 1e-9;
+        Summary {
+            samples,
+            intervals,
+            flat,
+            u_pi,
+            closure_max,
+            d4,
+            sector_sum,
+            developable,
+        }
+    }
+}
+
 /// Run `foldsynth vertex`.
 pub fn run(args: VertexArgs) -> Result<()> {
     let spec = VertexSpec::parse(&args.spec).context("invalid vertex")?;
     let ts = parse_range(&args.t)?;
-    let mode = spec.mode.sign();
-    let samples: Vec<Sample> = ts
-        .iter()
-        .map(|&t| {
-            let units = spec.units_at(t);
-            let mut state = solve_vertex(&units, &mode);
-            // φ can carry full turns (Sec. 4.4); report the fold angle in (−π, π].
-            state.phi = state.phi.map(crate::kinematics::wrap_angle);
-            let margin = state.margins.iter().copied().fold(f64::INFINITY, f64::min);
-            let rigid = margin >= -RIGID_TOL;
-            let closure = closure_residual(&units, &state.phi);
-            Sample {
-                t,
-                state,
-                rigid,
-                closure,
-            }
-        })
-        .collect();
-    let intervals = if ts.len() > 1 {
-        foldability::rigid_intervals(&ts, 1e-11, |t| foldability::min_margin(&spec, t))
-    } else {
-        samples
-            .iter()
-            .filter(|s| s.rigid)
-            .map(|s| [s.t, s.t])
-            .collect()
-    };
-    let (flat, u_pi) = flat_foldable(&spec.units_at(0.0), 1e-9);
-    let closure_max = samples
-        .iter()
-        .filter(|s| s.rigid)
-        .map(|s| s.closure)
-        .fold(0.0, f64::max);
-    let d4 = foldability::degree4(&spec);
-    let sector_sum: f64 = spec.sectors_rad().iter().sum();
-    let developable = (sector_sum - 2.0 * std::f64::consts::PI).abs() < 1e-9;
-
+    let s = Summary::new(&spec, &ts);
     if args.json {
-        let samples_json: Vec<_> = samples
-            .iter()
-            .map(|s| {
-                json!({
-                    "t": s.t, "U": s.state.u, "theta": s.state.theta, "beta": s.state.beta,
-                    "delta": s.state.delta, "phi": s.state.phi, "rigid": s.rigid,
-                    "margins": s.state.margins, "closure": s.closure,
-                })
-            })
-            .collect();
-        let mut out = json!({
-            "vertex": spec.to_string(),
-            "degree": spec.degree(),
-            "mode": spec.mode.to_string(),
-            "developable": developable,
-            "samples": samples_json,
-            "rigid_intervals": intervals,
-            "flat_foldable": flat,
-            "U_pi": u_pi,
-            "closure_max": closure_max,
-        });
-        if let Some(d) = &d4 {
-            out["degree4"] = json!({
-                "adjacent": d.adjacent, "opposite": d.opposite,
-                "eq13_sufficient": d.sufficient, "rho_star": d.rho_star,
-            });
-        }
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&summary_json(&spec, &s))?
+        );
         return Ok(());
     }
+    print_text(&spec, &s);
+    Ok(())
+}
 
-    let deg = |x: f64| x.to_degrees();
+/// `--json` (radians).
+fn summary_json(spec: &VertexSpec, s: &Summary) -> serde_json::Value {
+    let samples_json: Vec<_> = s
+        .samples
+        .iter()
+        .map(|s| {
+            json!({
+                "t": s.t, "U": s.state.u, "theta": s.state.theta, "beta": s.state.beta,
+                "delta": s.state.delta, "phi": s.state.phi, "rigid": s.rigid,
+                "margins": s.state.margins, "closure": s.closure,
+            })
+        })
+        .collect();
+    let mut out = json!({
+        "vertex": spec.to_string(),
+        "degree": spec.degree(),
+        "mode": spec.mode.to_string(),
+        "developable": s.developable,
+        "samples": samples_json,
+        "rigid_intervals": s.intervals,
+        "flat_foldable": s.flat,
+        "U_pi": s.u_pi,
+        "closure_max": s.closure_max,
+    });
+    if let Some(d) = &s.d4 {
+        out["degree4"] = json!({
+            "adjacent": d.adjacent, "opposite": d.opposite,
+            "eq13_sufficient": d.sufficient, "rho_star": d.rho_star,
+        });
+    }
+    out
+}
+
+fn deg(x: f64) -> f64 {
+    x.to_degrees()
+}
+
+/// The text report (degrees).
+fn print_text(spec: &VertexSpec, s: &Summary) {
     println!(
         "vertex {spec}  (degree {}, mode {})",
         spec.degree(),
         spec.mode
     );
-    if !developable {
+    if !s.developable {
         println!(
             "note: sector angles sum to {:.6}°, not 360° (the PTU does not need developability)",
-            deg(sector_sum)
+            deg(s.sector_sum)
         );
     }
     println!();
+    print_table(&s.samples);
+    println!();
+    println!(
+        "(angles in degrees; t in radians; φ wrapped to (−180°, 180°]; φ1 between u2 and u3, φ2 between u3 and u1, φ3 between u1 and u2)"
+    );
+    if s.intervals.is_empty() {
+        println!("rigid intervals: none in the sampled range");
+    } else {
+        let list: Vec<String> = s
+            .intervals
+            .iter()
+            .map(|[a, b]| format!("[{a:.10}, {b:.10}]"))
+            .collect();
+        println!(
+            "rigid intervals (Eq. 25, ends by bisection to 1e-10): {}",
+            list.join(", ")
+        );
+    }
+    println!(
+        "flat foldable (Eq. 26): {}  U(π) = ({:.6}°, {:.6}°, {:.6}°)",
+        if s.flat { "yes" } else { "no" },
+        deg(s.u_pi[0]),
+        deg(s.u_pi[1]),
+        deg(s.u_pi[2])
+    );
+    if let Some(d) = &s.d4 {
+        print_degree4(d);
+    }
+    println!(
+        "worst closure residual over the rigid samples: {:.3e}",
+        s.closure_max
+    );
+}
+
+/// One row per sample: U, θ, β, δ, φ and rigidity.
+fn print_table(samples: &[Sample]) {
     println!(
         "{:>9} | {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8} | {:>8} {:>8} {:>8} | {:>9} {:>9} {:>9} | rigid",
         "t",
@@ -194,7 +274,7 @@ pub fn run(args: VertexArgs) -> Result<()> {
         "φ2",
         "φ3"
     );
-    for s in &samples {
+    for s in samples {
         let st = &s.state;
         println!(
             "{:>9.5} | {:>8.3} {:>8.3} {:>8.3} | {:>8.3} {:>8.3} {:>8.3} | {:>8.3} {:>8.3} {:>8.3} | {:>8.3} {:>8.3} {:>8.3} | {:>9.3} {:>9.3} {:>9.3} | {}",
@@ -217,52 +297,29 @@ pub fn run(args: VertexArgs) -> Result<()> {
             if s.rigid { "yes" } else { "no" }
         );
     }
-    println!();
+}
+
+/// A degree-4 vertex's sectors, Eq. 13 and the extreme driving angle.
+fn print_degree4(d: &foldability::Degree4) {
     println!(
-        "(angles in degrees; t in radians; φ wrapped to (−180°, 180°]; φ1 between u2 and u3, φ2 between u3 and u1, φ3 between u1 and u2)"
-    );
-    if intervals.is_empty() {
-        println!("rigid intervals: none in the sampled range");
-    } else {
-        let list: Vec<String> = intervals
-            .iter()
-            .map(|[a, b]| format!("[{a:.10}, {b:.10}]"))
-            .collect();
-        println!(
-            "rigid intervals (Eq. 25, ends by bisection to 1e-10): {}",
-            list.join(", ")
-        );
-    }
-    println!(
-        "flat foldable (Eq. 26): {}  U(π) = ({:.6}°, {:.6}°, {:.6}°)",
-        if flat { "yes" } else { "no" },
-        deg(u_pi[0]),
-        deg(u_pi[1]),
-        deg(u_pi[2])
-    );
-    if let Some(d) = &d4 {
-        println!(
-            "degree 4: adjacent sectors ({:.4}°, {:.4}°), opposite ({:.4}°, {:.4}°); Eq. 13 |α1−α4| ≥ |α2−α3|: {}",
-            deg(d.adjacent[0]),
-            deg(d.adjacent[1]),
-            deg(d.opposite[0]),
-            deg(d.opposite[1]),
-            if d.sufficient {
-                "yes, rigid for every driving angle"
-            } else {
-                "no"
-            }
-        );
-        match d.rho_star {
-            Some(r) => println!(
-                "          extreme driving angle ρ1* (Eq. 14) = ±{r:.10} rad (±{:.6}°)",
-                deg(r)
-            ),
-            None => println!(
-                "          extreme driving angle ρ1* (Eq. 14): none, the driving angle reaches ±π"
-            ),
+        "degree 4: adjacent sectors ({:.4}°, {:.4}°), opposite ({:.4}°, {:.4}°); Eq. 13 |α1−α4| ≥ |α2−α3|: {}",
+        deg(d.adjacent[0]),
+        deg(d.adjacent[1]),
+        deg(d.opposite[0]),
+        deg(d.opposite[1]),
+        if d.sufficient {
+            "yes, rigid for every driving angle"
+        } else {
+            "no"
         }
+    );
+    match d.rho_star {
+        Some(r) => println!(
+            "          extreme driving angle ρ1* (Eq. 14) = ±{r:.10} rad (±{:.6}°)",
+            deg(r)
+        ),
+        None => println!(
+            "          extreme driving angle ρ1* (Eq. 14): none, the driving angle reaches ±π"
+        ),
     }
-    println!("worst closure residual over the rigid samples: {closure_max:.3e}");
-    Ok(())
 }

@@ -4,15 +4,17 @@
 //! and gradients checked against ours. Everything Symbolica runs on its own thread
 //! (`compile::symbolica`); the timing loops run there too.
 
+use super::fastest;
+#[cfg(feature = "symbolica")]
+use super::{rel, time_ns};
+#[cfg(feature = "symbolica")]
+use crate::compile::symbolica::{BuildReport, Job, Peer};
+use crate::expr::{ExprGraph, Names, NodeId};
 use anyhow::Result;
 use serde_json::json;
 use std::time::Duration;
 
-#[cfg(feature = "symbolica")]
-use crate::compile::symbolica::{BuildReport, Job, Peer};
-use crate::expr::{ExprGraph, Names, NodeId};
-
-/// What `foldsynth bench` hands the peer: named outputs of our graph as built.
+/// What a benchmark hands the peer: named outputs of our graph as built.
 pub struct PeerJob {
     /// The graph.
     pub graph: ExprGraph,
@@ -44,14 +46,8 @@ pub struct SymbolicaPeer {
     interpreted_ns: Vec<f64>,
 }
 
-#[cfg(feature = "symbolica")]
-fn rel(a: f64, b: f64) -> f64 {
-    (a - b).abs() / a.abs().max(b.abs()).max(1.0)
-}
-
-fn fastest(v: &[f64]) -> f64 {
-    v.iter().copied().fold(f64::INFINITY, f64::min)
-}
+/// The error of every Symbolica option in a build without the feature.
+pub const NO_SYMBOLICA: &str = "this foldsynth was built without Symbolica; rebuild with `cargo build --release --features symbolica`";
 
 impl SymbolicaPeer {
     /// Build Symbolica's pipeline for `job` (`reps` times, the median build time is the
@@ -110,13 +106,12 @@ impl SymbolicaPeer {
     /// Without the `symbolica` feature there is no peer.
     #[cfg(not(feature = "symbolica"))]
     pub fn new(_: PeerJob, _: Vec<f64>, _: &[f64], _: usize) -> Result<SymbolicaPeer> {
-        anyhow::bail!("--peer symbolica: {}", super::formulas::NO_SYMBOLICA)
+        anyhow::bail!("--peer symbolica: {}", NO_SYMBOLICA)
     }
 
     /// One round of timings (`slice` per row), on the Symbolica thread.
     #[cfg(feature = "symbolica")]
     pub fn round(&mut self, slice: Duration) -> Result<()> {
-        use super::bench::time_ns;
         use std::hint::black_box;
         let x = self.inputs.clone();
         let (nv, nvg) = (
@@ -149,7 +144,7 @@ impl SymbolicaPeer {
     /// Without the feature: unreachable, [`SymbolicaPeer::new`] fails first.
     #[cfg(not(feature = "symbolica"))]
     pub fn round(&mut self, _: Duration) -> Result<()> {
-        anyhow::bail!("--peer symbolica: {}", super::formulas::NO_SYMBOLICA)
+        anyhow::bail!("--peer symbolica: {}", NO_SYMBOLICA)
     }
 
     /// Fastest value+gradient time over the rounds (JIT), ns.
