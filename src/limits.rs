@@ -2,7 +2,7 @@
 //!
 //! Each limit is far above what a task needs (the thesis's tasks use N_max = 3, 16 states,
 //! 16 starts) and low enough that the run fits in memory and ends: a value beyond it is
-//! refused with a message naming the limit, never attempted. The README's "Limits" table
+//! refused with a message naming the limit, never attempted. The table in docs/limits.md
 //! lists them.
 
 /// Largest N_max (task files and `--n-max`). The graphs grow about twentyfold per
@@ -43,7 +43,7 @@ pub fn check_count(what: &str, value: u64, min: u64, max: u64) -> Result<(), Str
         Err(format!("{what} {value} is too small: at least {min}"))
     } else if value > max {
         Err(format!(
-            "{what} {value} is over the limit of {max} (foldsynth's limits keep every run in bounded memory and time; see the README)"
+            "{what} {value} is over the limit of {max} (foldsynth's limits keep every run in bounded memory and time; see docs/limits.md)"
         ))
     } else {
         Ok(())
@@ -60,7 +60,7 @@ pub fn count<const MIN: u64, const MAX: u64>(s: &str) -> Result<usize, String> {
     })?;
     if v < MIN || v > MAX {
         return Err(format!(
-            "{v} is out of range: allowed {MIN} to {MAX} (see the README's limits)"
+            "{v} is out of range: allowed {MIN} to {MAX} (see docs/limits.md)"
         ));
     }
     usize::try_from(v).map_err(|_| format!("{v} does not fit this machine's word size"))
