@@ -1036,3 +1036,50 @@ fn bad_copies_are_refused() {
     ));
     assert_err(&e, "copies", &["second_arm", "both"]);
 }
+
+#[test]
+fn meshes_over_the_limits_are_refused() {
+    let dir = std::env::temp_dir().join(format!("foldsynth_limits_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Over the byte limit (a sparse file: nothing is written).
+    let big = dir.join("big.stl");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(foldsynth::scene::mesh::MESH_BYTES_MAX + 1)
+        .unwrap();
+    let text = format!("{BASE}[[obstacles]]\nshape = \"mesh\"\nfile = \"big.stl\"\n");
+    let e = Task::from_toml_str_in(&text, "bad.toml", &dir).unwrap_err();
+    assert_err(
+        &e,
+        "obstacles[0].file",
+        &["big.stl", "limited to 33554432 bytes"],
+    );
+    // A part of 20,000 triangles (the limit of one mesh), named six times: over the limit
+    // of all the meshes of a task together.
+    let n = foldsynth::scene::mesh::MESH_TRIANGLES_MAX;
+    let mut stl = vec![0u8; 80];
+    stl.extend_from_slice(&(n as u32).to_le_bytes());
+    for k in 0..n {
+        stl.extend_from_slice(&[0u8; 12]);
+        let x = k as f32;
+        for p in [[x, 0.0, 0.0], [x + 1.0, 0.0, 0.0], [x, 1.0, 0.0]] {
+            for c in p {
+                stl.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        stl.extend_from_slice(&[0, 0]);
+    }
+    std::fs::write(dir.join("part.stl"), &stl).unwrap();
+    let one = "[[obstacles]]\nshape = \"mesh\"\nfile = \"part.stl\"\n";
+    let text = format!("{BASE}{}", one.repeat(5));
+    let t = Task::from_toml_str_in(&text, "ok.toml", &dir).unwrap();
+    assert_eq!(t.scene.obstacles.len(), 5);
+    let text = format!("{BASE}{}", one.repeat(6));
+    let e = Task::from_toml_str_in(&text, "bad.toml", &dir).unwrap_err();
+    assert_err(
+        &e,
+        "obstacles[5].file",
+        &["part.stl", "120000 triangles", "100000"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
