@@ -19,6 +19,21 @@ pub const SWEEP_MAX: usize = 10_000;
 pub const STATES_MAX: usize = 1_000;
 /// Most samples of `vertex --t A:B:N`.
 pub const SAMPLES_MAX: usize = 100_000;
+/// Most samples of one range of `t` in a task file (`t = "a .. b"`, `samples = N`: a
+/// path target, an orientation over a range): each sample is a term of the compiled model.
+pub const PATH_SAMPLES_MAX: usize = 1_000;
+/// Most targets of a task after its ranges are expanded into samples (each is a term of
+/// the compiled objective).
+pub const TARGETS_MAX: usize = 10_000;
+/// Most entries of each list of a task file (`[[objective.targets]]`, `[[obstacles]]`,
+/// `[[constraints.orientation]]`, `[[constraints.fold_limits]]`, `[[constraints.inside]]`).
+pub const TERMS_MAX: usize = 1_000;
+/// Most rotational copies of the arm (`[copies] n`): the model keeps the arm clear of
+/// ⌊n/2⌋ of them at every state.
+pub const COPIES_MAX: usize = 12;
+/// Most triangles of all the meshes one task names together (each mesh holds at most
+/// [`crate::scene::mesh::MESH_TRIANGLES_MAX`]).
+pub const MESH_TRIANGLES_TOTAL_MAX: usize = 100_000;
 /// Most worker threads (`--jobs`).
 pub const JOBS_MAX: usize = 256;
 /// Most folding steps of the bar-and-hinge simulation (`--steps`, `motion.steps`).

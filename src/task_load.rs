@@ -20,7 +20,8 @@ impl Task {
             field: "(file)".into(),
             message: format!("cannot read the task file: {e}"),
         })?;
-        let mut task = Task::from_toml_str(&text, &label)?;
+        let dir = path.parent().unwrap_or(Path::new(""));
+        let mut task = Task::from_toml_str_in(&text, &label, dir)?;
         task.source = Some(path.to_owned());
         if task.name.is_empty() {
             // The file stem, cut to the limit (the output directory is made safe from it).
@@ -37,15 +38,22 @@ impl Task {
         Ok(task)
     }
 
-    /// Parse and validate task text; `file` labels the messages.
+    /// Parse and validate task text; `file` labels the messages. Mesh files named by a
+    /// relative path are read from the current directory.
     pub fn from_toml_str(text: &str, file: &str) -> Result<Task, TaskError> {
+        Task::from_toml_str_in(text, file, Path::new(""))
+    }
+
+    /// Parse and validate task text; `file` labels the messages, mesh files named by a
+    /// relative path are read from `dir` (the task file's folder).
+    pub fn from_toml_str_in(text: &str, file: &str, dir: &Path) -> Result<Task, TaskError> {
         let mut draft = Draft::parse(text, file)?;
         check_facets(&draft.cx, &draft.initial)?;
         if draft.symmetry.mirror_xz {
             draft.initial.mirror = Some(mirror_map(&draft.cx, &draft.initial, draft.tol)?);
             check_mirror_order(&draft.cx, &draft.initial)?;
         }
-        draft.finish()
+        draft.finish(dir)
     }
 }
 

@@ -12,7 +12,7 @@ use proptest::prelude::*;
 #[test]
 fn a_short_run_of_every_target_has_no_panic() {
     fuzz::quiet_panics();
-    let r = fuzz::run_batch(&Target::ALL, 20_260_501, 0, 2_100, None);
+    let r = fuzz::run_batch(&Target::ALL, 20_260_501, 0, 2_400, None);
     let _ = std::panic::take_hook();
     let panics: Vec<_> = r.findings.iter().filter(|f| f.kind == "panic").collect();
     assert!(panics.is_empty(), "{panics:#?}");
@@ -22,6 +22,28 @@ fn a_short_run_of_every_target_has_no_panic() {
         // The mutations keep some inputs valid, so the fuzzer reaches past the parser.
         assert!(c.accepted > 0, "{}: nothing accepted", t.name());
     }
+}
+
+#[test]
+fn mutated_mesh_files_are_answered_without_a_panic() {
+    use foldsynth::scene::TriangleMesh;
+    fuzz::quiet_panics();
+    let r = fuzz::run_batch(&[Target::Mesh], 20_261_203, 0, 1_500, None);
+    let _ = std::panic::take_hook();
+    assert!(r.findings.is_empty(), "{:#?}", r.findings);
+    let c = &r.targets["mesh"];
+    // Some mutations keep a readable mesh, others break it.
+    assert!(c.accepted > 0 && c.accepted < c.inputs, "{c:?}");
+    // A binary STL that announces 4 billion triangles in 84 bytes is refused before
+    // anything is allocated for them; so is one announcing just over the limit.
+    for n in [u32::MAX, 20_001] {
+        let mut b = vec![0u8; 80];
+        b.extend_from_slice(&n.to_le_bytes());
+        let e = TriangleMesh::from_stl(&b).unwrap_err();
+        assert!(e.contains(&format!("{n} triangles")), "{e}");
+    }
+    // An OBJ face naming a vertex far beyond the file's is an error.
+    assert!(TriangleMesh::from_obj(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4000000000\n").is_err());
 }
 
 #[test]
@@ -124,9 +146,9 @@ fn the_fuzz_command_runs_batches_in_child_processes() {
         .args([
             "fuzz",
             "--inputs",
-            "140",
+            "160",
             "--batch",
-            "70",
+            "80",
             "--jobs",
             "2",
             "--seed",
@@ -143,7 +165,7 @@ fn the_fuzz_command_runs_batches_in_child_processes() {
         String::from_utf8_lossy(&out.stderr)
     );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!(v["inputs"], 140);
+    assert_eq!(v["inputs"], 160);
     assert_eq!(v["panics"], 0);
     assert_eq!(v["aborts"], 0);
     assert_eq!(v["hangs"], 0);

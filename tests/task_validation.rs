@@ -585,3 +585,501 @@ fn bad_robustness_values_are_refused_with_file_and_field() {
     let e = err(&with("[check]\nstates = 16\noptimize_states = 1\n"));
     assert_err(&e, "check.optimize_states", &["at least 2"]);
 }
+
+/// `BASE` with the motion `[0, pi/2]` and `extra`.
+fn moving(extra: &str) -> String {
+    format!("{BASE}[motion]\nt_max = \"pi/2\"\n{extra}")
+}
+
+/// An objective with one target whose fields are `fields`.
+fn target(fields: &str) -> String {
+    moving(&format!(
+        "[objective]\nthreshold = 0.1\n[[objective.targets]]\n{fields}\n"
+    ))
+}
+
+/// A mesh fixture's absolute path.
+fn mesh(name: &str) -> String {
+    format!("{}/tests/data/meshes/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn bad_targets_are_refused_with_file_and_field() {
+    let f = "objective.targets[0]";
+    let cases: &[(&str, String, &[&str])] = &[
+        // Expressions with t: an unknown name is named.
+        (
+            "t = 1\npoint = [\"2*s\", 0, 0]",
+            format!("{f}.point[0]"),
+            &["unknown name `s`", "t,"],
+        ),
+        (
+            "t = \"0 .. 1\"\nsamples = 3\npoint = [\"1/(t - 0.5)\", 0, 0]",
+            format!("{f}.point[0]"),
+            &["at t = 0.5", "not a finite number"],
+        ),
+        (
+            "t = 1\npoint = [\"nan\", 0, 0]",
+            format!("{f}.point[0]"),
+            &["unknown name `nan`"],
+        ),
+        // Ranges and samples.
+        (
+            "t = \"0 .. 1\"\nsamples = 1\npoint = [0, 0, 1]",
+            format!("{f}.samples"),
+            &["2 ≤ samples ≤ 1000"],
+        ),
+        (
+            "t = \"0 .. 1\"\nsamples = 1001\npoint = [0, 0, 1]",
+            format!("{f}.samples"),
+            &["2 ≤ samples ≤ 1000"],
+        ),
+        (
+            "t = \"0 .. 1\"\npoint = [0, 0, 1]",
+            format!("{f}.samples"),
+            &["missing", "samples = N"],
+        ),
+        (
+            "t = 1\nsamples = 3\npoint = [0, 0, 1]",
+            format!("{f}.samples"),
+            &["one value"],
+        ),
+        (
+            "t = \"1 .. 0\"\nsamples = 3\npoint = [0, 0, 1]",
+            format!("{f}.t"),
+            &["backwards"],
+        ),
+        (
+            "t = \"1 .. 1\"\nsamples = 3\npoint = [0, 0, 1]",
+            format!("{f}.t"),
+            &["empty"],
+        ),
+        (
+            "t = \"0 .. 2\"\nsamples = 3\npoint = [0, 0, 1]",
+            format!("{f}.t"),
+            &["outside the motion range"],
+        ),
+        (
+            "t = \"0 .. t\"\nsamples = 3\npoint = [0, 0, 1]",
+            format!("{f}.t"),
+            &["end", "unknown name `t`"],
+        ),
+        (
+            "t = \"0 .. 1 .. 2\"\nsamples = 3\npoint = [0, 0, 1]",
+            format!("{f}.t"),
+            &["\"a .. b\""],
+        ),
+        // Vertices and goals.
+        (
+            "vertex = \"s4\"\nt = 1\npoint = [0, 0, 1]",
+            format!("{f}.vertex"),
+            &["unknown vertex \"s4\"", "tip, s1, s2, s3, last", "v1, v2"],
+        ),
+        ("t = 1", f.to_owned(), &["no goal", "exactly one of point"]),
+        (
+            "t = 1\npoint = [0, 0, 1]\nplane = { point = [0, 0, 1], normal = [0, 0, 1] }",
+            f.to_owned(),
+            &["2 goals (point, plane)"],
+        ),
+        (
+            "t = 1\nline = { point = [0, 0, 1], direction = [0, 0, 0] }",
+            format!("{f}.line.direction"),
+            &["zero length"],
+        ),
+        (
+            "t = 1\nplane = { point = [0, 0, 1], normal = [0, \"1e-300\", 0] }",
+            format!("{f}.plane.normal"),
+            &["zero length"],
+        ),
+        (
+            "t = 1\nplane = { point = [0, inf, 1], normal = [0, 0, 1] }",
+            format!("{f}.plane.point[1]"),
+            &["not a finite number"],
+        ),
+        (
+            "t = 1\npoint = [0, 0, 1]\nweight = 0",
+            format!("{f}.weight"),
+            &["> 0"],
+        ),
+    ];
+    for (fields, field, words) in cases {
+        assert_err(&err(&target(fields)), field, words);
+    }
+}
+
+#[test]
+fn bad_surfaces_and_mesh_obstacles_name_the_file_and_the_field() {
+    let surface = |file: &str, extra: &str| {
+        target(&format!("t = 1\nsurface = {{ file = \"{file}\"{extra} }}"))
+    };
+    let f = "objective.targets[0].surface";
+    for (name, words) in [
+        ("garbage.stl", &["not a readable STL"][..]),
+        ("no_faces.obj", &["no triangles"][..]),
+        ("empty.stl", &["no triangles"][..]),
+        ("huge_count.stl", &["30000", "20000"][..]),
+        ("sheet.ply", &["unknown mesh format", "STL", "OBJ"][..]),
+        ("missing.stl", &["cannot read the mesh file"][..]),
+    ] {
+        let e = err(&surface(&mesh(name), ""));
+        assert_err(&e, &format!("{f}.file"), words);
+        assert!(e.message.contains(&mesh(name)), "{e}");
+    }
+    let e = err(&surface(&mesh("sheet.obj"), ", scale = 0"));
+    assert_err(&e, &format!("{f}.scale"), &["> 0"]);
+    let e = err(&surface(&mesh("sheet.obj"), ", translate = [0, 0]"));
+    assert_err(&e, &format!("{f}.translate"), &["exactly 3"]);
+    let e = err(&surface(
+        &mesh("sheet.obj"),
+        ", scale = 1e6, translate = [1e6, 0, 0]",
+    ));
+    assert_err(&e, &format!("{f}.scale"), &["sheet.obj", "beyond"]);
+    let e = err(&surface(&mesh(""), ""));
+    assert_err(&e, &format!("{f}.file"), &["meshes", "not a regular file"]);
+    let e = err(&surface("", ""));
+    assert_err(&e, &format!("{f}.file"), &["empty"]);
+    // The same checks for a mesh obstacle.
+    let e = err(&format!(
+        "{BASE}[[obstacles]]\nshape = \"mesh\"\nfile = \"{}\"\n",
+        mesh("garbage.stl")
+    ));
+    assert_err(&e, "obstacles[0].file", &["garbage.stl", "STL"]);
+    // Relative paths start from the task file's folder.
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/meshes");
+    let text = format!("{BASE}[[obstacles]]\nshape = \"mesh\"\nfile = \"tetra.stl\"\n");
+    Task::from_toml_str_in(&text, "ok.toml", &dir).unwrap();
+    let e = Task::from_toml_str_in(&text, "bad.toml", std::path::Path::new("/nonexistent"))
+        .unwrap_err();
+    assert_err(
+        &e,
+        "obstacles[0].file",
+        &["/nonexistent/tetra.stl", "cannot read"],
+    );
+}
+
+#[test]
+fn bad_area_terms_are_refused() {
+    let area = |fields: &str| moving(&format!("[objective.area]\n{fields}\n"));
+    let f = "objective.area";
+    let cases: &[(&str, String, &[&str])] = &[
+        (
+            "kind = \"volume\"",
+            format!("{f}.kind"),
+            &["\"flat\"", "\"packing\""],
+        ),
+        (
+            "kind = \"flat\"\nt = 1",
+            format!("{f}.t"),
+            &["only for kind = \"packing\""],
+        ),
+        ("kind = \"packing\"", format!("{f}.t"), &["missing"]),
+        (
+            "kind = \"packing\"\nt = 3",
+            format!("{f}.t"),
+            &["outside the motion range"],
+        ),
+        (
+            "kind = \"packing\"\nt = \"0 .. 1\"",
+            format!("{f}.t"),
+            &["is a range"],
+        ),
+        (
+            "kind = \"flat\"\nweight = 0",
+            format!("{f}.weight"),
+            &["> 0"],
+        ),
+        (
+            "kind = \"flat\"\nweight = -inf",
+            format!("{f}.weight"),
+            &["not a finite number"],
+        ),
+        (
+            "kind = \"flat\"\nat_least = -1",
+            format!("{f}.at_least"),
+            &["≥ 0"],
+        ),
+    ];
+    for (fields, field, words) in cases {
+        assert_err(&err(&area(fields)), field, words);
+    }
+    // Targets need a threshold; without targets an area term alone is an objective.
+    let e = err(&moving(
+        "[objective]\n[[objective.targets]]\nt = 1\npoint = [0, 0, 1]\n",
+    ));
+    assert_err(&e, "objective.threshold", &["missing"]);
+    let e = err(&moving("[objective]\nthreshold = 1\n"));
+    assert_err(&e, "objective.targets", &["[objective.area]"]);
+}
+
+#[test]
+fn bad_requirements_are_refused_with_file_and_field() {
+    let c = "constraints";
+    let ori = |fields: &str| {
+        moving(&format!(
+            "[[constraints.orientation]]\ndirection = [0, 0, -1]\ntolerance = 0.1\n{fields}\n"
+        ))
+    };
+    let o = "constraints.orientation[0]";
+    let cases: Vec<(String, String, &[&str])> = vec![
+        (
+            ori("t = 1\nvertex = \"v9\""),
+            format!("{o}.vertex"),
+            &["unknown vertex \"v9\""],
+        ),
+        (
+            ori("t = 1\nof = \"facet\""),
+            format!("{o}.of"),
+            &["\"facet_left\""],
+        ),
+        (
+            moving("[[constraints.orientation]]\ndirection = [0, 0, 0]\ntolerance = 0.1\nt = 1\n"),
+            format!("{o}.direction"),
+            &["zero length"],
+        ),
+        (
+            ori("t = 1\nangle = 4"),
+            format!("{o}.angle"),
+            &["0 ≤ angle ≤ pi"],
+        ),
+        (
+            moving("[[constraints.orientation]]\ndirection = [0, 0, 1]\ntolerance = 0\nt = 1\n"),
+            format!("{o}.tolerance"),
+            &["> 0"],
+        ),
+        (
+            ori("t = \"0 .. 1\"\nsamples = 1"),
+            format!("{o}.samples"),
+            &["2 ≤ samples"],
+        ),
+        (
+            ori("t = 2"),
+            format!("{o}.t"),
+            &["outside the motion range"],
+        ),
+        (
+            ori("t = 1\nname = \"\""),
+            format!("{o}.name"),
+            &["1 to 64 characters"],
+        ),
+        (
+            format!(
+                "{BASE}[[constraints.orientation]]\ndirection = [0, 0, 1]\ntolerance = 0.1\nt = 1\n"
+            ),
+            format!("{c}.orientation"),
+            &["[motion]"],
+        ),
+        (
+            moving("[constraints]\nmax_fold = \"pi\""),
+            format!("{c}.max_fold"),
+            &["0 < max < pi"],
+        ),
+        (
+            moving("[constraints]\nmax_fold = 0"),
+            format!("{c}.max_fold"),
+            &["0 < max < pi"],
+        ),
+        (
+            moving("[[constraints.fold_limits]]\ncrease = \"v1-v3\"\nmax = 1"),
+            format!("{c}.fold_limits[0].crease"),
+            &["unknown crease", "v1, v2"],
+        ),
+        (
+            moving("[[constraints.fold_limits]]\ncrease = \"v1-v1\"\nmax = 1"),
+            format!("{c}.fold_limits[0].crease"),
+            &["no crease of G0 joins"],
+        ),
+        (
+            moving("[[constraints.fold_limits]]\ncrease = \"tip\"\nmax = -1"),
+            format!("{c}.fold_limits[0].max"),
+            &["0 < max < pi"],
+        ),
+    ];
+    for (text, field, words) in &cases {
+        assert_err(&err(text), field, words);
+    }
+}
+
+#[test]
+fn degenerate_boxes_and_bad_obstacles_are_refused() {
+    let inside = |fields: &str| moving(&format!("[[constraints.inside]]\n{fields}\n"));
+    let i = "constraints.inside[0]";
+    let obstacle = |fields: &str| format!("{BASE}[[obstacles]]\n{fields}\n");
+    let b = "obstacles[0]";
+    let cases: Vec<(String, String, &[&str])> = vec![
+        (
+            inside("min = [0, 0, 0]\nmax = [1, 0, 1]"),
+            format!("{i}.max[1]"),
+            &["max must exceed min"],
+        ),
+        (
+            inside("min = [0, 0, 0]\nmax = [1, -1, 1]"),
+            format!("{i}.max[1]"),
+            &["max must exceed min"],
+        ),
+        (inside("min = [0, 0, 0]"), format!("{i}.max"), &["missing"]),
+        (
+            inside("min = [0, 0, 0]\nmax = [1, 1, 1]\ncenter = [0, 0, 0]"),
+            format!("{i}.center"),
+            &["one form"],
+        ),
+        (
+            inside("center = [0, 0, 0]\nhalf_extents = [1, 0, 1]"),
+            format!("{i}.half_extents[1]"),
+            &["> 0"],
+        ),
+        (
+            inside(
+                "center = [0, 0, 0]\nhalf_extents = [1, 1, 1]\nx_axis = [1, 0, 0]\ny_axis = [2, 0, 0]",
+            ),
+            format!("{i}.y_axis"),
+            &["parallel"],
+        ),
+        (
+            inside("center = [0, 0, 0]\nhalf_extents = [1, 1, 1]\nx_axis = [0, 0, 0]"),
+            format!("{i}.x_axis"),
+            &["zero length"],
+        ),
+        (
+            inside("min = [0, 0, 0]\nmax = [1, 1, 1]\nt = 5"),
+            format!("{i}.t"),
+            &["outside the motion range"],
+        ),
+        (
+            inside("min = [0, 0, \"-inf\"]\nmax = [1, 1, 1]"),
+            format!("{i}.min[2]"),
+            &["unknown name"],
+        ),
+        (
+            inside("min = [0, 0, -inf]\nmax = [1, 1, 1]"),
+            format!("{i}.min[2]"),
+            &["not a finite number"],
+        ),
+        (
+            obstacle("shape = \"cone\""),
+            format!("{b}.shape"),
+            &[
+                "\"cylinder\"",
+                "\"sphere\"",
+                "\"box\"",
+                "\"halfspace\"",
+                "\"mesh\"",
+            ],
+        ),
+        (
+            obstacle("shape = \"sphere\"\ncenter = [0, 0, 0]"),
+            format!("{b}.radius"),
+            &["missing"],
+        ),
+        (
+            obstacle("shape = \"sphere\"\ncenter = [0, 0, 0]\nradius = 0"),
+            format!("{b}.radius"),
+            &["> 0"],
+        ),
+        (
+            obstacle("shape = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nnormal = [0, 0, 1]"),
+            format!("{b}.normal"),
+            &["belongs to another shape"],
+        ),
+        (
+            obstacle("shape = \"cylinder\"\nradius = 1\nfrom = [0, 0, 1]\nto = [0, 0, 1]"),
+            format!("{b}.to"),
+            &["distinct"],
+        ),
+        (
+            obstacle("shape = \"box\"\nmin = [0, 0, 0]\nmax = [0, 1, 1]"),
+            format!("{b}.max[0]"),
+            &["max must exceed min"],
+        ),
+        (
+            obstacle("shape = \"box\"\ncenter = [0, 0, 0]\nhalf_extents = [1, 1, -1]"),
+            format!("{b}.half_extents[2]"),
+            &["> 0"],
+        ),
+        (
+            obstacle("shape = \"halfspace\"\npoint = [0, 0, 0]\nnormal = [0, 0, 0]"),
+            format!("{b}.normal"),
+            &["zero length"],
+        ),
+        (
+            obstacle("shape = \"mesh\""),
+            format!("{b}.file"),
+            &["missing"],
+        ),
+        (
+            obstacle("shape = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nname = \"a\\nb\""),
+            format!("{b}.name"),
+            &["control characters"],
+        ),
+    ];
+    for (text, field, words) in &cases {
+        assert_err(&err(text), field, words);
+    }
+}
+
+#[test]
+fn bad_copies_are_refused() {
+    let copies = |fields: &str| format!("{BASE}[copies]\n{fields}\n");
+    assert_err(&err(&copies("n = 0")), "copies.n", &["1 ≤ n ≤ 12"]);
+    assert_err(&err(&copies("n = 13")), "copies.n", &["1 ≤ n ≤ 12"]);
+    assert_err(
+        &err(&copies("n = 3\naxis = { direction = [0, 0, 0] }")),
+        "copies.axis.direction",
+        &["zero length"],
+    );
+    assert_err(
+        &err(&copies("n = 3\naxis = { point = [0, nan, 0] }")),
+        "copies.axis.point[1]",
+        &["not a finite number"],
+    );
+    let e = err(&format!(
+        "{BASE}[check]\nstates = 4\nsecond_arm = true\n[copies]\nn = 2\n"
+    ));
+    assert_err(&e, "copies", &["second_arm", "both"]);
+}
+
+#[test]
+fn meshes_over_the_limits_are_refused() {
+    let dir = std::env::temp_dir().join(format!("foldsynth_limits_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Over the byte limit (a sparse file: nothing is written).
+    let big = dir.join("big.stl");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(foldsynth::scene::mesh::MESH_BYTES_MAX + 1)
+        .unwrap();
+    let text = format!("{BASE}[[obstacles]]\nshape = \"mesh\"\nfile = \"big.stl\"\n");
+    let e = Task::from_toml_str_in(&text, "bad.toml", &dir).unwrap_err();
+    assert_err(
+        &e,
+        "obstacles[0].file",
+        &["big.stl", "limited to 33554432 bytes"],
+    );
+    // A part of 20,000 triangles (the limit of one mesh), named six times: over the limit
+    // of all the meshes of a task together.
+    let n = foldsynth::scene::mesh::MESH_TRIANGLES_MAX;
+    let mut stl = vec![0u8; 80];
+    stl.extend_from_slice(&(n as u32).to_le_bytes());
+    for k in 0..n {
+        stl.extend_from_slice(&[0u8; 12]);
+        let x = k as f32;
+        for p in [[x, 0.0, 0.0], [x + 1.0, 0.0, 0.0], [x, 1.0, 0.0]] {
+            for c in p {
+                stl.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        stl.extend_from_slice(&[0, 0]);
+    }
+    std::fs::write(dir.join("part.stl"), &stl).unwrap();
+    let one = "[[obstacles]]\nshape = \"mesh\"\nfile = \"part.stl\"\n";
+    let text = format!("{BASE}{}", one.repeat(5));
+    let t = Task::from_toml_str_in(&text, "ok.toml", &dir).unwrap();
+    assert_eq!(t.scene.obstacles.len(), 5);
+    let text = format!("{BASE}{}", one.repeat(6));
+    let e = Task::from_toml_str_in(&text, "bad.toml", &dir).unwrap_err();
+    assert_err(
+        &e,
+        "obstacles[5].file",
+        &["part.stl", "120000 triangles", "100000"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

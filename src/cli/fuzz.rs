@@ -27,7 +27,7 @@ pub struct FuzzArgs {
     /// Seed: the same seed gives the same inputs.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Targets, comma-separated: task, vertex, expr, fold, design, pattern, records
+    /// Targets, comma-separated: task, vertex, expr, fold, design, pattern, records, mesh
     /// (default: all).
     #[arg(long, value_delimiter = ',')]
     pub targets: Vec<String>,

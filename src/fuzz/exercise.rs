@@ -217,3 +217,21 @@ pub fn records(text: &str) -> bool {
     assert_eq!(keys.len(), kept.len(), "a key was reused twice");
     !kept.is_empty()
 }
+
+/// Mesh bytes: read as STL (ASCII or binary) and as OBJ; each mesh read is scaled, moved,
+/// bounded and walked triangle by triangle.
+pub fn mesh(bytes: &[u8]) -> bool {
+    use crate::scene::TriangleMesh;
+    let mut accepted = false;
+    for read in [TriangleMesh::from_stl(bytes), TriangleMesh::from_obj(bytes)] {
+        let Ok(mut m) = read else { continue };
+        accepted = true;
+        let _ = m.bounding_ball();
+        m.transform(2.5, [1.0, -2.0, 0.5]);
+        let _ = m.bounds();
+        for i in 0..m.triangles.len() {
+            let _ = m.triangle(i);
+        }
+    }
+    accepted
+}

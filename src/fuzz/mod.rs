@@ -15,6 +15,7 @@
 //! | `design` | [`crate::export::DesignFile::parse`] | FOLD, SVG, OBJ, STL, pictures |
 //! | `pattern` | [`crate::simulate::PatternFile::parse`] | one simulation step on small patterns |
 //! | `records` | `alternatives.jsonl` ([`crate::search::output::parse_records`]) | the resume invariant: every line reused or reported |
+//! | `mesh` | STL (ASCII, binary) and OBJ bytes ([`crate::scene::TriangleMesh::from_stl`], [`crate::scene::TriangleMesh::from_obj`]) | bounds, the triangles, scaling |
 //!
 //! How each input is made: a third are seeds mutated as trees (TOML/JSON values replaced,
 //! deleted, duplicated, nested; for the notations, generated from their grammar), a third
@@ -54,11 +55,13 @@ pub enum Target {
     Pattern,
     /// `alternatives.jsonl` as `--resume` reads it.
     Records,
+    /// Mesh files (STL ASCII or binary, OBJ) as a task's obstacles and surfaces read them.
+    Mesh,
 }
 
 impl Target {
     /// Every target.
-    pub const ALL: [Target; 7] = [
+    pub const ALL: [Target; 8] = [
         Target::Task,
         Target::Vertex,
         Target::Expr,
@@ -66,6 +69,7 @@ impl Target {
         Target::Design,
         Target::Pattern,
         Target::Records,
+        Target::Mesh,
     ];
 
     /// The name used on the command line and in reports.
@@ -78,6 +82,7 @@ impl Target {
             Target::Design => "design",
             Target::Pattern => "pattern",
             Target::Records => "records",
+            Target::Mesh => "mesh",
         }
     }
 
@@ -94,6 +99,7 @@ impl Target {
             Target::Fold => "fold",
             Target::Design => "json",
             Target::Records => "jsonl",
+            Target::Mesh => "mesh",
         }
     }
 }
@@ -130,11 +136,22 @@ fn mix(seed: u64, index: u64, target: u64) -> u64 {
 
 /// Run one input of `target` (see the module docs for what it reaches).
 pub fn exercise(target: Target, input: &[u8]) -> Outcome {
-    // Files are read as UTF-8 text: anything else is refused before parsing.
-    let Ok(text) = std::str::from_utf8(input) else {
-        return Outcome::Rejected;
-    };
     let accepted = match target {
+        // Mesh files may be binary (STL).
+        Target::Mesh => exercise::mesh(input),
+        // Files are read as UTF-8 text: anything else is refused before parsing.
+        _ => std::str::from_utf8(input).is_ok_and(|text| text_target(target, text)),
+    };
+    if accepted {
+        Outcome::Accepted
+    } else {
+        Outcome::Rejected
+    }
+}
+
+/// Run one text input of `target`; whether the parser accepted it.
+fn text_target(target: Target, text: &str) -> bool {
+    match target {
         Target::Task => exercise::task(text),
         Target::Vertex => exercise::vertex(text),
         Target::Expr => exercise::expr(text),
@@ -142,11 +159,7 @@ pub fn exercise(target: Target, input: &[u8]) -> Outcome {
         Target::Design => exercise::design(text),
         Target::Pattern => exercise::pattern(text),
         Target::Records => exercise::records(text),
-    };
-    if accepted {
-        Outcome::Accepted
-    } else {
-        Outcome::Rejected
+        Target::Mesh => exercise::mesh(text.as_bytes()),
     }
 }
 

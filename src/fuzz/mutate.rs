@@ -168,7 +168,48 @@ fn structured(target: Target, seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
         Target::Task | Target::Pattern => toml_tree(seed, rng),
         Target::Fold | Target::Design => json_tree(seed, rng),
         Target::Records => records(seed, rng),
+        Target::Mesh => mesh(seed, rng),
     }
+}
+
+/// A mutation of a mesh file that keeps its form: a binary STL's triangle count rewritten
+/// (the reader must not trust it), or lines of a text file repeated, dropped or given an
+/// interesting number.
+fn mesh(seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
+    let mut b = seed.to_vec();
+    if b.len() >= 84 && !b.starts_with(b"solid") {
+        let counts = [0, 1, 3, 5, 19_999, 20_001, 1 << 24, u32::MAX];
+        let n = counts[rng.random_range(0..counts.len())];
+        b[80..84].copy_from_slice(&n.to_le_bytes());
+        if rng.random_bool(0.5) {
+            let len = b.len();
+            b.truncate(rng.random_range(84..=len));
+        }
+        return b;
+    }
+    let mut lines: Vec<Vec<u8>> = b.split(|&c| c == b'\n').map(<[u8]>::to_vec).collect();
+    for _ in 0..rng.random_range(1..4) {
+        let i = rng.random_range(0..lines.len());
+        match rng.random_range(0..3) {
+            0 => {
+                let line = lines[i].clone();
+                let times = rng.random_range(1..64);
+                lines.splice(i..i, std::iter::repeat_n(line, times));
+            }
+            1 if lines.len() > 1 => {
+                lines.remove(i);
+            }
+            _ => {
+                let words: Vec<&[u8]> = lines[i].split(|&c| c == b' ').collect();
+                let j = rng.random_range(0..words.len());
+                let n = generate::NUMBERS[rng.random_range(0..generate::NUMBERS.len())];
+                let mut out: Vec<Vec<u8>> = words.iter().map(|w| w.to_vec()).collect();
+                out[j] = n.as_bytes().to_vec();
+                lines[i] = out.join(&b' ');
+            }
+        }
+    }
+    lines.join(&b'\n')
 }
 
 /// A step of a path into a value tree.

@@ -48,33 +48,28 @@ pub struct MeshError {
 impl TriangleMesh {
     /// Read an STL (`.stl`, ASCII or binary) or OBJ (`.obj`) file, chosen by extension.
     pub fn read(path: &Path) -> Result<TriangleMesh, MeshError> {
-        let err = |message: String| MeshError {
-            file: path.display().to_string(),
-            message,
-        };
-        let size = std::fs::metadata(path)
-            .map_err(|e| err(format!("cannot read the mesh file: {e}")))?
-            .len();
-        if size > MESH_BYTES_MAX {
-            return Err(err(format!(
-                "{size} bytes: mesh files are limited to {MESH_BYTES_MAX} bytes (decimate the part first)"
-            )));
-        }
-        let bytes =
-            std::fs::read(path).map_err(|e| err(format!("cannot read the mesh file: {e}")))?;
+        TriangleMesh::parse(path, &read_bytes(path)?)
+    }
+
+    /// Parse the bytes of the file `path` (STL or OBJ by its extension; the path labels
+    /// the messages).
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<TriangleMesh, MeshError> {
         let ext = path
             .extension()
             .map(|e| e.to_string_lossy().to_ascii_lowercase())
             .unwrap_or_default();
         match ext.as_str() {
-            "stl" => TriangleMesh::from_stl(&bytes),
-            "obj" => TriangleMesh::from_obj(&bytes),
+            "stl" => TriangleMesh::from_stl(bytes),
+            "obj" => TriangleMesh::from_obj(bytes),
             _ => Err(format!(
                 "unknown mesh format {:?}: use an STL (.stl, ASCII or binary) or OBJ (.obj) file",
-                ext
+                crate::text::excerpt(&ext, 20)
             )),
         }
-        .map_err(err)
+        .map_err(|message| MeshError {
+            file: path.display().to_string(),
+            message,
+        })
     }
 
     /// Parse STL bytes (ASCII or binary).
@@ -244,6 +239,42 @@ impl TriangleMesh {
         }
         (lo, hi)
     }
+}
+
+/// The bytes of the mesh file `path`: a regular file (not a directory, a device or a
+/// pipe, which could block or never end) of at most [`MESH_BYTES_MAX`] bytes, read no
+/// further than that limit even if it grows meanwhile.
+pub fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
+    use std::io::Read;
+    let err = |message: String| MeshError {
+        file: path.display().to_string(),
+        message,
+    };
+    let cannot = |e: std::io::Error| err(format!("cannot read the mesh file: {e}"));
+    let meta = std::fs::metadata(path).map_err(cannot)?;
+    if !meta.is_file() {
+        return Err(err(
+            "is not a regular file: a mesh is an STL or OBJ file".into()
+        ));
+    }
+    let too_big = |size: u64| {
+        err(format!(
+            "{size} bytes: mesh files are limited to {MESH_BYTES_MAX} bytes (decimate the part first)"
+        ))
+    };
+    if meta.len() > MESH_BYTES_MAX {
+        return Err(too_big(meta.len()));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    std::fs::File::open(path)
+        .map_err(cannot)?
+        .take(MESH_BYTES_MAX + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > MESH_BYTES_MAX {
+        return Err(too_big(bytes.len() as u64));
+    }
+    Ok(bytes)
 }
 
 fn check_count(n: usize) -> Result<(), String> {

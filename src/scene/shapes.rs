@@ -125,14 +125,22 @@ impl PartialEq for MeshObstacle {
 }
 
 impl MeshObstacle {
-    /// Read the file (STL, ASCII or binary, or OBJ), scale and translate it.
+    /// Read the file (STL, ASCII or binary, or OBJ), scale and translate it (once: a
+    /// loaded mesh is kept).
     pub fn load(&mut self) -> Result<&TriangleMesh, MeshError> {
         if self.mesh.is_none() {
-            let mut m = TriangleMesh::read(&self.file)?;
-            m.transform(self.scale, self.translate);
-            self.mesh = Some(Arc::new(m));
+            let bytes = super::mesh::read_bytes(&self.file)?;
+            self.load_bytes(&bytes)?;
         }
         Ok(self.mesh.as_deref().expect("loaded above"))
+    }
+
+    /// Parse `bytes` as the contents of the file (read by the caller, who also digests
+    /// them), scale and translate the mesh and keep it.
+    pub fn load_bytes(&mut self, bytes: &[u8]) -> Result<&TriangleMesh, MeshError> {
+        let mut m = TriangleMesh::parse(&self.file, bytes)?;
+        m.transform(self.scale, self.translate);
+        Ok(&**self.mesh.insert(Arc::new(m)))
     }
 
     /// The loaded triangles (`None` before [`MeshObstacle::load`]).

@@ -2,6 +2,7 @@
 
 use serde::Deserialize;
 
+use super::solids::cylinder;
 use super::{Ctx, Number, TaskError};
 
 /// A cylinder obstacle (axis segment `a → b` and radius): one of the scene's shapes.
@@ -63,6 +64,7 @@ pub(crate) fn build(
     let Some(c) = raw else {
         return Ok((None, legacy));
     };
+    cx.entries("check.cylinders", c.cylinders.len())?;
     let max = crate::limits::STATES_MAX as i64;
     if !(2..=max).contains(&c.states) {
         return Err(cx.err(
@@ -86,7 +88,13 @@ pub(crate) fn build(
     for (i, cy) in c.cylinders.iter().enumerate() {
         legacy.obstacles.push(Obstacle {
             name: format!("check.cylinders[{i}]"),
-            shape: Shape::Cylinder(cylinder(cx, i, cy)?),
+            shape: Shape::Cylinder(cylinder(
+                cx,
+                &format!("check.cylinders[{i}]"),
+                &cy.radius,
+                &cy.from,
+                &cy.to,
+            )?),
         });
     }
     legacy.copies = c.second_arm.then(|| Copies::about_z(2));
@@ -95,29 +103,4 @@ pub(crate) fn build(
         optimize_states: optimize_states as usize,
     };
     Ok((Some(check), legacy))
-}
-
-/// Obstacle `i`: a positive radius, an axis of two distinct points.
-fn cylinder(cx: &Ctx<'_>, i: usize, cy: &RawCylinder) -> Result<Cylinder, TaskError> {
-    let f = format!("check.cylinders[{i}]");
-    let radius = cx.num(&format!("{f}.radius"), &cy.radius)?;
-    if radius <= 0.0 {
-        return Err(cx.err(
-            format!("{f}.radius"),
-            format!("{radius} is not allowed: the radius must be > 0"),
-        ));
-    }
-    let from = cx.point(&format!("{f}.from"), &cy.from)?;
-    let to = cx.point(&format!("{f}.to"), &cy.to)?;
-    if from == to {
-        return Err(cx.err(
-            format!("{f}.to"),
-            "the axis end equals its start: the axis needs two distinct points",
-        ));
-    }
-    Ok(Cylinder {
-        a: from,
-        b: to,
-        radius,
-    })
 }

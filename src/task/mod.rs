@@ -36,14 +36,20 @@ mod constraints;
 mod ctx;
 mod drive;
 mod initial;
+mod meshes;
 mod mirror;
 mod motion;
+mod names;
 pub mod number;
 mod objective;
+mod obstacles;
 pub(crate) mod parse;
 mod robustness;
 mod rotation;
+mod solids;
+mod targets;
 pub mod terms;
+pub mod times;
 
 use std::path::PathBuf;
 
@@ -126,9 +132,27 @@ pub const N_MAX_LIMIT: usize = crate::limits::N_MAX;
 
 /// FNV-1a (64 bits) of `bytes`, as 16 hex digits: enough to notice an edited file.
 pub fn digest(bytes: &[u8]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    format!("{:016x}", fnv(FNV_START, bytes))
+}
+
+/// FNV-1a's offset basis.
+const FNV_START: u64 = 0xcbf2_9ce4_8422_2325;
+
+/// FNV-1a (64 bits) of `bytes`, continuing from `h`.
+fn fnv(mut h: u64, bytes: &[u8]) -> u64 {
     for b in bytes {
         h = (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+/// The digest of a task: its text's ([`digest`]) when it names no mesh file; otherwise
+/// FNV-1a of the text followed by each mesh file's FNV-1a (`meshes`, in the order the task
+/// names them), so that editing a mesh changes the task.
+fn task_digest(text: &str, meshes: &[u64]) -> String {
+    let mut h = fnv(FNV_START, text.as_bytes());
+    for m in meshes {
+        h = fnv(h, &m.to_le_bytes());
     }
     format!("{h:016x}")
 }

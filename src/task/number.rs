@@ -2,8 +2,10 @@
 //! `"17*pi/18"` or `"1 + 2*cos(pi/20)"`.
 //!
 //! Angles like π/18 are exact in the thesis; writing them as expressions keeps the task
-//! files readable and free of truncated decimals. (Driving angles, which use `t`, are
-//! parsed by the kinematics module's `DriveExpr`.)
+//! files readable and free of truncated decimals. Where a task allows it (a target's point,
+//! a line's or plane's point), an expression may use the driving parameter `t`
+//! ([`Expr::parse_with_t`], [`Number::value_at`]); everywhere else `t` is an unknown name.
+//! (Driving angles of G0's creases are parsed by the kinematics module's `DriveExpr`.)
 
 use std::fmt;
 
@@ -15,16 +17,33 @@ use serde::{Deserialize, Serialize, Serializer};
 pub enum Number {
     /// A literal float or integer.
     Literal(f64),
-    /// An expression in numbers, `pi`, `+ - * / ^`, parentheses, `sin`, `cos`, `sqrt`.
+    /// An expression in numbers, `pi`, `+ - * / ^`, parentheses, `sin`, `cos`, `sqrt`
+    /// (and `t` where the field allows it).
     Expr(String),
 }
 
 impl Number {
-    /// The value; `Err` names what is wrong with the expression.
+    /// The value of a constant; `Err` names what is wrong with the expression (`t` is an
+    /// unknown name here).
     pub fn value(&self) -> Result<f64, String> {
         match self {
             Number::Literal(v) => Ok(*v),
             Number::Expr(s) => Ok(Expr::parse(s)?.eval()),
+        }
+    }
+
+    /// The value at `t` of a number that may use `t`; `Err` names what is wrong with the
+    /// expression.
+    pub fn value_at(&self, t: f64) -> Result<f64, String> {
+        Ok(self.parse_with_t()?.eval_at(t))
+    }
+
+    /// The number as an expression that may use `t` (a literal is a constant), parsed once
+    /// to be evaluated at many `t`.
+    pub fn parse_with_t(&self) -> Result<Expr, String> {
+        match self {
+            Number::Literal(v) => Ok(Expr::Const(*v)),
+            Number::Expr(s) => Expr::parse_with_t(s),
         }
     }
 }
@@ -72,11 +91,14 @@ impl<'de> Deserialize<'de> for Number {
     }
 }
 
-/// A parsed constant arithmetic expression.
+/// A parsed arithmetic expression: constants, and the variable `t` when parsed with
+/// [`Expr::parse_with_t`].
 #[derive(Clone, Debug, PartialEq)]
 pub enum Expr {
     /// A constant.
     Const(f64),
+    /// The driving parameter `t`.
+    Var,
     /// Negation.
     Neg(Box<Expr>),
     /// A binary operation: one of `+ - * / ^`.
@@ -86,8 +108,17 @@ pub enum Expr {
 }
 
 impl Expr {
-    /// Parse `s`.
+    /// Parse the constant expression `s` (`t` is an unknown name).
     pub fn parse(s: &str) -> Result<Expr, String> {
+        Expr::parse_in(s, false)
+    }
+
+    /// Parse `s`, which may use the driving parameter `t`.
+    pub fn parse_with_t(s: &str) -> Result<Expr, String> {
+        Expr::parse_in(s, true)
+    }
+
+    fn parse_in(s: &str, with_t: bool) -> Result<Expr, String> {
         crate::limits::check_expression(s).map_err(|(at, m)| {
             format!(
                 "{m} (at character {} of \"{}\")",
@@ -95,7 +126,11 @@ impl Expr {
                 crate::text::excerpt(s, 60)
             )
         })?;
-        let mut p = Parser { src: s, pos: 0 };
+        let mut p = Parser {
+            src: s,
+            pos: 0,
+            with_t,
+        };
         p.skip_ws();
         if p.pos == s.len() {
             return Err("empty expression".into());
@@ -113,13 +148,22 @@ impl Expr {
         Ok(e)
     }
 
-    /// The value.
+    /// The value of a constant expression (one that uses `t` evaluates to NaN: parse it
+    /// with [`Expr::parse_with_t`] and use [`Expr::eval_at`]).
     pub fn eval(&self) -> f64 {
+        self.eval_at(f64::NAN)
+    }
+
+    /// The value at `t`: the same floating-point operations in the same order as the
+    /// expression with `t`'s value written in (so `"2*cos(t)"` at `t = pi/20` gives the
+    /// bits of `"2*cos(pi/20)"`).
+    pub fn eval_at(&self, t: f64) -> f64 {
         match self {
             Expr::Const(c) => *c,
-            Expr::Neg(a) => -a.eval(),
+            Expr::Var => t,
+            Expr::Neg(a) => -a.eval_at(t),
             Expr::Bin(op, a, b) => {
-                let (a, b) = (a.eval(), b.eval());
+                let (a, b) = (a.eval_at(t), b.eval_at(t));
                 match op {
                     '+' => a + b,
                     '-' => a - b,
@@ -129,7 +173,7 @@ impl Expr {
                 }
             }
             Expr::Call(f, a) => {
-                let a = a.eval();
+                let a = a.eval_at(t);
                 match *f {
                     "sin" => a.sin(),
                     "cos" => a.cos(),
@@ -143,6 +187,8 @@ impl Expr {
 struct Parser<'a> {
     src: &'a str,
     pos: usize,
+    /// Whether `t` is a name.
+    with_t: bool,
 }
 
 impl Parser<'_> {
@@ -237,6 +283,7 @@ impl Parser<'_> {
                 self.pos += end;
                 match word {
                     "pi" | "PI" | "Pi" => Ok(Expr::Const(std::f64::consts::PI)),
+                    "t" if self.with_t => Ok(Expr::Var),
                     "sin" | "cos" | "sqrt" => {
                         let name: &'static str = match word {
                             "sin" => "sin",
@@ -248,8 +295,12 @@ impl Parser<'_> {
                         }
                         Ok(Expr::Call(name, Box::new(self.atom()?)))
                     }
+                    _ if self.with_t => Err(format!(
+                        "unknown name `{}` (allowed: numbers, pi, t, sin, cos, sqrt, + - * / ^, parentheses)",
+                        crate::text::excerpt(word, 40)
+                    )),
                     _ => Err(format!(
-                        "unknown name `{}` (allowed: numbers, pi, sin, cos, sqrt, + - * / ^, parentheses)",
+                        "unknown name `{}` (allowed: numbers, pi, sin, cos, sqrt, + - * / ^, parentheses; t only in a target's point)",
                         crate::text::excerpt(word, 40)
                     )),
                 }
@@ -279,6 +330,27 @@ mod tests {
         assert_eq!(v("1e-5"), 1e-5);
         assert_eq!(v("2.5E+1"), 25.0);
         assert_eq!(v("sqrt(4)"), 2.0);
+    }
+
+    #[test]
+    fn t_evaluates_like_its_value_written_in() {
+        // The robotic arm's trajectory, as a path and as the points written out.
+        for k in 0..=10 {
+            let t = (f64::from(k) * (PI / 2.0)) / 10.0;
+            let written = format!("1 + 2*cos({k}*pi/20)");
+            let want = Expr::parse(&written).unwrap().eval();
+            let got = Expr::parse_with_t("1 + 2*cos(t)").unwrap().eval_at(t);
+            assert_eq!(got.to_bits(), want.to_bits(), "k = {k}");
+        }
+        assert_eq!(Number::Literal(2.5).value_at(9.0), Ok(2.5));
+        assert_eq!(Number::Expr("t^2 - t".into()).value_at(3.0), Ok(6.0));
+        let e = Number::Expr("2*s".into()).value_at(1.0).unwrap_err();
+        assert!(
+            e.contains("unknown name `s`") && e.contains("pi, t,"),
+            "{e}"
+        );
+        let e = Number::Expr("t".into()).value().unwrap_err();
+        assert!(e.contains("unknown name `t`"), "{e}");
     }
 
     #[test]

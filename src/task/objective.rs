@@ -1,23 +1,31 @@
-//! The `[objective]` table: points the gripping vertex should reach (Eq. 37–38).
+//! The `[objective]` table: targets the design's vertices should reach (Eq. 37–38,
+//! generalized to paths, lines, planes and surfaces; `[[objective.targets]]`, read by
+//! [`super::targets`]) and an optional area term to maximize (`[objective.area]`).
 
 use serde::Deserialize;
 
-use super::terms::{Goal, Objective, Target, VertexRef};
-use super::{Ctx, Motion, Number, TaskError};
+use super::meshes::Meshes;
+use super::targets::{RawTarget, Reader};
+use super::terms::{AreaKind, AreaTerm, Objective};
+use super::times::{Span, one};
+use super::{Ctx, InitialGraph, Motion, Number, TaskError};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawObjective {
-    threshold: Number,
+    threshold: Option<Number>,
+    #[serde(default)]
     targets: Vec<RawTarget>,
+    area: Option<RawArea>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-struct RawTarget {
-    t: Number,
-    point: Vec<Number>,
+struct RawArea {
+    kind: String,
+    t: Option<Number>,
     weight: Option<Number>,
+    at_least: Option<Number>,
 }
 
 /// The objective; its targets' t must lie in the motion range, so it needs `[motion]`.
@@ -25,6 +33,8 @@ pub(crate) fn build(
     cx: &Ctx<'_>,
     raw: Option<&RawObjective>,
     motion: Option<Motion>,
+    g0: &InitialGraph,
+    meshes: &mut Meshes<'_>,
 ) -> Result<Option<Objective>, TaskError> {
     let Some(o) = raw else { return Ok(None) };
     let Some(motion) = motion else {
@@ -33,62 +43,110 @@ pub(crate) fn build(
             "an objective needs the motion range: add [motion] with t_max",
         ));
     };
-    let threshold = cx.num("objective.threshold", &o.threshold)?;
+    let span = Span::of(motion);
+    if o.targets.is_empty() && o.area.is_none() {
+        return Err(cx.err(
+            "objective.targets",
+            "no targets: give at least one [[objective.targets]] with t and a goal (point, line, plane or surface), or an [objective.area] term",
+        ));
+    }
+    let threshold = match &o.threshold {
+        Some(n) => cx.num("objective.threshold", n)?,
+        // Without targets Ω is 0: any threshold is met.
+        None if o.targets.is_empty() => 0.0,
+        None => {
+            return Err(cx.err(
+                "objective.threshold",
+                "missing: Ω ≤ threshold meets the target; give threshold ≥ 0",
+            ));
+        }
+    };
     if threshold < 0.0 {
         return Err(cx.err(
             "objective.threshold",
             format!("{threshold} is not allowed: the threshold must be ≥ 0"),
         ));
     }
-    if o.targets.is_empty() {
-        return Err(cx.err(
-            "objective.targets",
-            "no targets: give at least one [[objective.targets]] with t and point",
-        ));
-    }
-    let (lo, hi) = if motion.t_max > 0.0 {
-        (0.0, motion.t_max)
-    } else {
-        (motion.t_max, 0.0)
+    cx.entries("objective.targets", o.targets.len())?;
+    let mut reader = Reader {
+        cx,
+        g0,
+        span,
+        meshes,
+        surfaces: Vec::new(),
     };
     let mut targets = Vec::with_capacity(o.targets.len());
     for (i, t) in o.targets.iter().enumerate() {
-        targets.push(target(cx, i, t, lo, hi)?);
+        targets.extend(reader.read(i, t)?);
+        let max = crate::limits::TARGETS_MAX;
+        if targets.len() > max {
+            return Err(cx.err(
+                format!("objective.targets[{i}]"),
+                format!(
+                    "{} targets with the samples of the entries up to this one: a task has at most {max}",
+                    targets.len()
+                ),
+            ));
+        }
     }
+    let area = o.area.as_ref().map(|a| area(cx, a, span)).transpose()?;
     Ok(Some(Objective {
         targets,
         threshold,
-        surfaces: Vec::new(),
-        area: None,
+        surfaces: reader.surfaces,
+        area,
     }))
 }
 
-/// Target `i`, its t within [lo, hi].
-fn target(cx: &Ctx<'_>, i: usize, t: &RawTarget, lo: f64, hi: f64) -> Result<Target, TaskError> {
-    let f = format!("objective.targets[{i}]");
-    let tv = cx.num(&format!("{f}.t"), &t.t)?;
-    if tv < lo - 1e-12 || tv > hi + 1e-12 {
-        return Err(cx.err(
-            format!("{f}.t"),
-            format!("{tv} is outside the motion range [{lo}, {hi}]"),
-        ));
-    }
-    let point = cx.point(&format!("{f}.point"), &t.point)?;
-    let weight = match &t.weight {
-        None => 1.0,
-        Some(w) => cx.num(&format!("{f}.weight"), w)?,
+/// `[objective.area]`: the kind (and packing's state), a weight > 0, a floor ≥ 0.
+fn area(cx: &Ctx<'_>, a: &RawArea, span: Span) -> Result<AreaTerm, TaskError> {
+    let kind = match (a.kind.as_str(), &a.t) {
+        ("flat", None) => AreaKind::Flat,
+        ("flat", Some(_)) => {
+            return Err(cx.err(
+                "objective.area.t",
+                "t is only for kind = \"packing\" (the flat area does not depend on the state): drop it",
+            ));
+        }
+        ("packing", Some(t)) => AreaKind::Packing {
+            t: one(cx, "objective.area.t", t, span)?,
+        },
+        ("packing", None) => {
+            return Err(cx.err(
+                "objective.area.t",
+                "missing: kind = \"packing\" needs t, the state whose bounding box counts",
+            ));
+        }
+        (other, _) => {
+            return Err(cx.err(
+                "objective.area.kind",
+                format!(
+                    "unknown kind \"{}\": allowed \"flat\" (the flat pattern's area) or \"packing\" (flat area over the folded footprint at t)",
+                    crate::text::excerpt(other, 40)
+                ),
+            ));
+        }
     };
-    if weight <= 0.0 {
+    let weight = match &a.weight {
+        None => 1.0,
+        Some(w) => cx.positive("objective.area.weight", w)?,
+    };
+    let at_least = match &a.at_least {
+        None => 0.0,
+        Some(n) => cx.num("objective.area.at_least", n)?,
+    };
+    if at_least < 0.0 {
         return Err(cx.err(
-            format!("{f}.weight"),
-            format!("{weight} is not allowed: weights must be > 0"),
+            "objective.area.at_least",
+            format!(
+                "{} is not allowed: at_least must be ≥ 0 (an area is never negative)",
+                crate::text::num(at_least)
+            ),
         ));
     }
-    Ok(Target {
-        t: tv,
-        vertex: VertexRef::Tip,
-        goal: Goal::Point { point },
+    Ok(AreaTerm {
+        kind,
         weight,
-        entry: i,
+        at_least,
     })
 }

@@ -10,7 +10,7 @@ use serde::Deserialize;
 use super::ctx::syntax_error;
 use super::{
     Ctx, InitialGraph, N_MAX_LIMIT, Symmetry, Task, TaskError, VertexType, bounds, check,
-    constraints, digest, initial, motion, objective, robustness,
+    constraints, initial, meshes::Meshes, motion, objective, obstacles, robustness, task_digest,
 };
 
 #[derive(Deserialize)]
@@ -28,6 +28,9 @@ struct RawTask {
     check: Option<check::RawCheck>,
     robustness: Option<robustness::RawRobustness>,
     constraints: Option<constraints::RawConstraints>,
+    #[serde(default)]
+    obstacles: Vec<obstacles::RawObstacle>,
+    copies: Option<obstacles::RawCopies>,
 }
 
 #[derive(Deserialize)]
@@ -94,8 +97,9 @@ impl<'a> Draft<'a> {
         })
     }
 
-    /// Check the remaining tables and assemble the task.
-    pub(crate) fn finish(self) -> Result<Task, TaskError> {
+    /// Check the remaining tables and assemble the task; mesh files named by a relative
+    /// path are read from `dir` (the task file's folder).
+    pub(crate) fn finish(self, dir: &std::path::Path) -> Result<Task, TaskError> {
         let Draft {
             cx,
             text,
@@ -118,18 +122,18 @@ impl<'a> Draft<'a> {
         }
         let motion = motion::build(&cx, raw.motion.as_ref())?;
         let bounds = bounds::build(&cx, raw.bounds.as_ref())?;
-        let objective = objective::build(&cx, raw.objective.as_ref(), motion)?;
+        let mut meshes = Meshes::new(dir);
+        let objective =
+            objective::build(&cx, raw.objective.as_ref(), motion, &initial, &mut meshes)?;
         let (check, legacy) = check::build(&cx, raw.check.as_ref())?;
-        let scene = crate::scene::Scene {
-            obstacles: legacy.obstacles,
-            copies: legacy.copies.unwrap_or_default(),
-            containment: Vec::new(),
-        };
+        let (requirements, containment) =
+            constraints::build(&cx, raw.constraints.as_ref(), motion, &initial)?;
+        let scene = scene(&cx, &raw, legacy, containment, &mut meshes)?;
         let robustness = robustness::build(&cx, raw.robustness.as_ref(), &initial)?;
 
         Ok(Task {
             name: name.trim().to_string(),
-            digest: digest(text.as_bytes()),
+            digest: task_digest(text, &meshes.digests),
             description: raw.description,
             source: None,
             initial,
@@ -140,11 +144,39 @@ impl<'a> Draft<'a> {
             objective,
             check,
             scene,
-            requirements: Default::default(),
+            requirements,
             robustness,
             kawasaki: constraints::kawasaki(raw.constraints.as_ref()),
         })
     }
+}
+
+/// The scene: the legacy `[[check.cylinders]]` first, then `[[obstacles]]`; the copies of
+/// `[copies]` or the legacy `second_arm` (not both); the boxes of `[[constraints.inside]]`.
+fn scene(
+    cx: &Ctx<'_>,
+    raw: &RawTask,
+    legacy: check::LegacyScene,
+    containment: Vec<crate::scene::Containment>,
+    meshes: &mut Meshes<'_>,
+) -> Result<crate::scene::Scene, TaskError> {
+    let mut obstacles = legacy.obstacles;
+    obstacles.extend(obstacles::build(cx, &raw.obstacles, meshes)?);
+    let copies = match (&raw.copies, legacy.copies) {
+        (Some(_), Some(_)) => {
+            return Err(cx.err(
+                "copies",
+                "[copies] and [check] second_arm = true both give the copies: keep [copies] (second_arm = true means n = 2 about the z-axis)",
+            ));
+        }
+        (Some(c), None) => obstacles::copies(cx, c)?,
+        (None, legacy) => legacy.unwrap_or_default(),
+    };
+    Ok(crate::scene::Scene {
+        obstacles,
+        copies,
+        containment,
+    })
 }
 
 /// Why `name` cannot name a task (it names the output directory `out/<name>`).
