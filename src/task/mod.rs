@@ -85,9 +85,14 @@ pub struct Task {
     /// The task's name (defaults to the file stem): at most [`crate::limits::NAME_MAX`]
     /// characters, no path separators, no `..`, no control characters.
     pub name: String,
-    /// Digest of the file's text (FNV-1a, 64 bits, hex): a search resumes only the same
-    /// task.
+    /// Digest of the file's text and of the mesh files it names (FNV-1a, 64 bits, hex;
+    /// [`digest_with_meshes`]): a search resumes only the same task. Without meshes it is
+    /// [`digest`] of the text.
     pub digest: String,
+    /// FNV-1a of the bytes of each mesh file the task names, in the order they were read
+    /// (the targets' surfaces, then `[[obstacles]]`): with the text they give
+    /// [`Task::digest`].
+    pub mesh_digests: Vec<u64>,
     /// Free text.
     pub description: Option<String>,
     /// Where it was loaded from, if from a file.
@@ -148,8 +153,8 @@ fn fnv(mut h: u64, bytes: &[u8]) -> u64 {
 
 /// The digest of a task: its text's ([`digest`]) when it names no mesh file; otherwise
 /// FNV-1a of the text followed by each mesh file's FNV-1a (`meshes`, in the order the task
-/// names them), so that editing a mesh changes the task.
-fn task_digest(text: &str, meshes: &[u64]) -> String {
+/// reads them: [`Task::mesh_digests`]), so that editing a mesh changes the task.
+pub fn digest_with_meshes(text: &str, meshes: &[u64]) -> String {
     let mut h = fnv(FNV_START, text.as_bytes());
     for m in meshes {
         h = fnv(h, &m.to_le_bytes());
