@@ -3,10 +3,14 @@
 //! A task file holds the initial graph G0 (vertices with in-plane coordinates and types,
 //! creases with their facet labels and driving angles), the grammar's limit N_max, the
 //! task's symmetry, and the design task the later stages use: the motion range, the
-//! variable bounds, the objective (points to reach at given t), the intersection-check
-//! setup (thesis Sec. 5.1, 5.5; SPEC §4) and optional design constraints (`[constraints]
-//! kawasaki = true`: flat-foldable vertices). Every field is checked on load; a bad file gets a
-//! [`TaskError`] naming the file, the field and what is allowed.
+//! variable bounds, the objective (points, paths, lines, planes and mesh surfaces to reach,
+//! an area to gain: [`terms`]), the intersection-check setup (thesis Sec. 5.1, 5.5; SPEC
+//! §4), the scene ([`crate::scene::Scene`]: `[[obstacles]]` of every shape, `[copies]`,
+//! `[[constraints.inside]]`) and the design constraints (`[constraints]`: `kawasaki = true`
+//! for flat-foldable vertices, orientations, fold-angle limits). Every field is checked on
+//! load; a bad file gets a [`TaskError`] naming the file, the field and what is allowed.
+//! Mesh files are read relative to the task file's folder
+//! ([`Task::from_toml_str_in`]) and their bytes enter [`Task::digest`].
 //!
 //! ```toml
 //! name = "gripper"
