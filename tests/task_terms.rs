@@ -377,6 +377,7 @@ fn the_digest_follows_the_mesh_files() {
     let plain = Task::load(data("robotic_arm_points.toml")).unwrap();
     let bytes = std::fs::read(data("robotic_arm_points.toml")).unwrap();
     assert_eq!(plain.digest, foldsynth::task::digest(&bytes));
+    assert!(plain.mesh_digests.is_empty());
     std::fs::remove_dir_all(&tmp).unwrap();
 }
 

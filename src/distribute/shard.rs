@@ -14,7 +14,7 @@ use super::DistributeError;
 use crate::search::output::ShardSpec;
 use crate::search::{self, Plan, SearchOptions, ShardReport, Share};
 use crate::task::Task;
-use crate::task::digest;
+use crate::task::digest_with_meshes;
 
 /// The units of each of `count` shards (shard k at index k − 1), each in record order.
 pub fn assign(plan: &Plan, count: usize) -> Vec<Vec<usize>> {
@@ -49,7 +49,7 @@ pub fn run(
     opts: &SearchOptions,
     spec: ShardSpec,
 ) -> Result<ShardReport, DistributeError> {
-    if digest(task_text.as_bytes()) != task.digest {
+    if digest_with_meshes(task_text, &task.mesh_digests) != task.digest {
         return Err(DistributeError::input(
             task.source
                 .as_deref()

@@ -3,10 +3,14 @@
 //! A task file holds the initial graph G0 (vertices with in-plane coordinates and types,
 //! creases with their facet labels and driving angles), the grammar's limit N_max, the
 //! task's symmetry, and the design task the later stages use: the motion range, the
-//! variable bounds, the objective (points to reach at given t), the intersection-check
-//! setup (thesis Sec. 5.1, 5.5; SPEC §4) and optional design constraints (`[constraints]
-//! kawasaki = true`: flat-foldable vertices). Every field is checked on load; a bad file gets a
-//! [`TaskError`] naming the file, the field and what is allowed.
+//! variable bounds, the objective (points, paths, lines, planes and mesh surfaces to reach,
+//! an area to gain: [`terms`]), the intersection-check setup (thesis Sec. 5.1, 5.5; SPEC
+//! §4), the scene ([`crate::scene::Scene`]: `[[obstacles]]` of every shape, `[copies]`,
+//! `[[constraints.inside]]`) and the design constraints (`[constraints]`: `kawasaki = true`
+//! for flat-foldable vertices, orientations, fold-angle limits). Every field is checked on
+//! load; a bad file gets a [`TaskError`] naming the file, the field and what is allowed.
+//! Mesh files are read relative to the task file's folder
+//! ([`Task::from_toml_str_in`]) and their bytes enter [`Task::digest`].
 //!
 //! ```toml
 //! name = "gripper"
@@ -85,9 +89,14 @@ pub struct Task {
     /// The task's name (defaults to the file stem): at most [`crate::limits::NAME_MAX`]
     /// characters, no path separators, no `..`, no control characters.
     pub name: String,
-    /// Digest of the file's text (FNV-1a, 64 bits, hex): a search resumes only the same
-    /// task.
+    /// Digest of the file's text and of the mesh files it names (FNV-1a, 64 bits, hex;
+    /// [`digest_with_meshes`]): a search resumes only the same task. Without meshes it is
+    /// [`digest`] of the text.
     pub digest: String,
+    /// FNV-1a of the bytes of each mesh file the task names, in the order they were read
+    /// (the targets' surfaces, then `[[obstacles]]`): with the text they give
+    /// [`Task::digest`].
+    pub mesh_digests: Vec<u64>,
     /// Free text.
     pub description: Option<String>,
     /// Where it was loaded from, if from a file.
@@ -148,8 +157,8 @@ fn fnv(mut h: u64, bytes: &[u8]) -> u64 {
 
 /// The digest of a task: its text's ([`digest`]) when it names no mesh file; otherwise
 /// FNV-1a of the text followed by each mesh file's FNV-1a (`meshes`, in the order the task
-/// names them), so that editing a mesh changes the task.
-fn task_digest(text: &str, meshes: &[u64]) -> String {
+/// reads them: [`Task::mesh_digests`]), so that editing a mesh changes the task.
+pub fn digest_with_meshes(text: &str, meshes: &[u64]) -> String {
     let mut h = fnv(FNV_START, text.as_bytes());
     for m in meshes {
         h = fnv(h, &m.to_le_bytes());

@@ -10,7 +10,8 @@ use serde::Deserialize;
 use super::ctx::syntax_error;
 use super::{
     Ctx, InitialGraph, N_MAX_LIMIT, Symmetry, Task, TaskError, VertexType, bounds, check,
-    constraints, initial, meshes::Meshes, motion, objective, obstacles, robustness, task_digest,
+    constraints, digest_with_meshes, initial, meshes::Meshes, motion, objective, obstacles,
+    robustness,
 };
 
 #[derive(Deserialize)]
@@ -133,7 +134,8 @@ impl<'a> Draft<'a> {
 
         Ok(Task {
             name: name.trim().to_string(),
-            digest: task_digest(text, &meshes.digests),
+            digest: digest_with_meshes(text, &meshes.digests),
+            mesh_digests: meshes.digests,
             description: raw.description,
             source: None,
             initial,
