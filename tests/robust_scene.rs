@@ -453,6 +453,14 @@ fn new_constraints_gradients_match_central_differences() {
                         normal: [0.6, 0.0, 0.8],
                     }),
                 ),
+                // Next to copy 1's tip: the copy's pairs with it get planes.
+                obstacle(
+                    "copy sphere",
+                    Shape::Sphere(Sphere {
+                        center: copies.apply(1, near),
+                        radius: 0.05,
+                    }),
+                ),
             ],
             containment: vec![Containment {
                 bounds: OrientedBox {
@@ -481,7 +489,13 @@ fn new_constraints_gradients_match_central_differences() {
                     match (pair.group, pair.kind) {
                         (Group::Obstacle, PairKind::Obstacle { k, .. }) => {
                             let o = block.pairs.obstacles[k].obstacle;
-                            let name = ["sphere", "cylinder", "box", "mesh"][o];
+                            let name = match block.spec.scene.obstacles[o].name.as_str() {
+                                "sphere" => "sphere",
+                                "cylinder" => "cylinder",
+                                "box" => "box",
+                                "mesh" => "mesh",
+                                _ => "other",
+                            };
                             Some(if pair.a.1 > 0 { "copy obstacle" } else { name })
                         }
                         (Group::Arm, _) => Some(match pair.b.unwrap().1 {
@@ -779,4 +793,121 @@ fn central_difference(g: f64, mut f: impl FnMut(f64) -> f64) -> f64 {
         }
     }
     best
+}
+
+/// A closed UV sphere of `slices · 2 · (stacks − 1)` triangles.
+fn uv_sphere(c: V3, r: f64, slices: usize, stacks: usize) -> TriangleMesh {
+    let mut vertices = vec![[c[0], c[1], c[2] + r]];
+    for i in 1..stacks {
+        let th = PI * i as f64 / stacks as f64;
+        for j in 0..slices {
+            let ph = 2.0 * PI * j as f64 / slices as f64;
+            vertices.push([
+                c[0] + r * th.sin() * ph.cos(),
+                c[1] + r * th.sin() * ph.sin(),
+                c[2] + r * th.cos(),
+            ]);
+        }
+    }
+    vertices.push([c[0], c[1], c[2] - r]);
+    let ring = |i: usize, j: usize| (1 + (i - 1) * slices + j % slices) as u32;
+    let bottom = (vertices.len() - 1) as u32;
+    let mut triangles = Vec::new();
+    for j in 0..slices {
+        triangles.push([0, ring(1, j), ring(1, j + 1)]);
+        triangles.push([bottom, ring(stacks - 1, j + 1), ring(stacks - 1, j)]);
+    }
+    for i in 1..stacks - 1 {
+        for j in 0..slices {
+            triangles.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
+            triangles.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
+        }
+    }
+    TriangleMesh {
+        vertices,
+        triangles,
+        closed: true,
+    }
+}
+
+/// A 5,000-triangle mesh next to the pattern: every triangle is a piece with its own
+/// pairs, but only those whose bounding ball comes within reach of a facet's get a plane;
+/// the time a state's fit takes is printed (debug build).
+#[test]
+fn a_large_mesh_fits_planes_only_near_the_pattern() {
+    use foldsynth::model::robust::ACTIVATE;
+    use std::time::Instant;
+    let task = Task::load(GRIPPER).unwrap();
+    let (model, x, modes) = models(&task, 1, 0.0).remove(0);
+    let bare = RobustModel::new(&model, spec_with(&task, Scene::default())).unwrap();
+    let (_, _, p, t) = extent(&bare, &x, &modes, model.gripping);
+    let mesh = uv_sphere([p[0], p[1], p[2] + 0.55], 0.5, 50, 51);
+    assert_eq!(mesh.triangles.len(), 5000);
+    let tris: Vec<[V3; 3]> = (0..mesh.triangles.len())
+        .map(|i| mesh.triangle(i))
+        .collect();
+    let scene = Scene {
+        obstacles: vec![obstacle(
+            "part",
+            Shape::Mesh(MeshObstacle {
+                file: "part.stl".into(),
+                scale: 1.0,
+                translate: [0.0; 3],
+                mesh: Some(Arc::new(mesh)),
+            }),
+        )],
+        ..Scene::default()
+    };
+    let block = RobustModel::new(&model, spec_with(&task, scene)).unwrap();
+    let nf = block.pairs.facets.len();
+    assert_eq!(block.pairs.pairs.len(), bare.pairs.pairs.len() + 5000 * nf);
+    let mut work = block.work();
+    block.eval(&x, &modes, t, &mut work);
+    let mut planes = vec![None; block.pairs.pairs.len()];
+    let mut buffers = Buffers::default();
+    let start = Instant::now();
+    let reps = 5;
+    for _ in 0..reps {
+        planes.iter_mut().for_each(|p| *p = None);
+        block.fit(
+            &work.values,
+            &mut planes,
+            |_| false,
+            Level::Imposed,
+            FULL,
+            &mut buffers,
+        );
+    }
+    let per_state = start.elapsed().as_secs_f64() / reps as f64;
+    let base = bare.pairs.pairs.len();
+    let fitted = planes[base..].iter().filter(|p| p.is_some()).count();
+    // Within reach by the triangles' own balls (centroid, farthest corner): an upper bound
+    // on the pairs the block may fit.
+    let need = block.wall_gap(Level::Imposed) + ACTIVATE;
+    let s = &work.values.scene;
+    let mut reach = 0;
+    for f in 0..nf {
+        let (c, r) = s.sphere(f, 0, nf);
+        for tri in &tris {
+            let m = [0, 1, 2].map(|i| (tri[0][i] + tri[1][i] + tri[2][i]) / 3.0);
+            let d = |a: V3, b: V3| {
+                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+            };
+            let rt = tri.iter().map(|q| d(*q, m)).fold(0.0, f64::max);
+            if d(c, m) - rt - r <= need + 1e-9 {
+                reach += 1;
+            }
+        }
+    }
+    eprintln!(
+        "5000-triangle mesh, {nf} facets: {fitted} planes fitted of {} pairs ({reach} within \
+         reach by balls), fit {:.2} ms per state (debug build)",
+        5000 * nf,
+        per_state * 1e3
+    );
+    assert!(
+        fitted > 0 && fitted <= reach,
+        "{fitted} fitted, {reach} within reach"
+    );
+    assert!(reach < 5000 * nf / 4, "the mesh is mostly far: {reach}");
 }

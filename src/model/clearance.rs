@@ -79,7 +79,7 @@ impl Scene {
         self.x.clear();
         self.x.extend_from_slice(x);
         self.copies.clear();
-        for k in 1..map.n().max(2) {
+        for k in 1..map.n() {
             self.copies.extend(x.iter().map(|p| map.point(k, *p)));
         }
         self.spheres.clear();
@@ -92,7 +92,7 @@ impl Scene {
             self.spheres.push((c, r));
         }
         let n = self.spheres.len();
-        for k in 1..map.n().max(2) {
+        for k in 1..map.n() {
             for f in 0..n {
                 let (c, r) = self.spheres[f];
                 self.spheres.push((map.point(k, c), r));

@@ -81,7 +81,7 @@ pub const SAFETY: f64 = 1e-2;
 pub const CLEARANCE_FLOOR: f64 = 1e-6;
 /// Pairs whose bounding spheres are farther apart than the required gap plus this (paper
 /// units; radians for cones) get no plane.
-const ACTIVATE: f64 = 0.05;
+pub const ACTIVATE: f64 = 0.05;
 /// A sampled state joins the merit while one of its constraints is within this of its
 /// bound (or carries a multiplier).
 const LIVE: f64 = 0.05;
