@@ -694,7 +694,7 @@ impl RobustModel {
                 visit(base + k, m - req, Dep::Margin(k));
             }
         }
-        self.visit_walls(t, v, level, |slot, h, dep| visit(slot, h, dep));
+        self.visit_walls(t, v, level, visit);
     }
 
     /// Visit the half-space and box constraints at `t` (a box with its own t only there):
@@ -733,15 +733,11 @@ impl RobustModel {
                 for vertex in 0..nv {
                     let r = VRef { vertex, copy };
                     let q = bounds.local(v.scene.at(r));
-                    for i in 0..3 {
+                    for (i, qi) in q.into_iter().enumerate() {
                         let room = bounds.half[i] - g;
                         let a = bounds.axes[i];
-                        visit(
-                            slot,
-                            room - q[i],
-                            Dep::X(&[(r, crate::geom::scale(a, -1.0))]),
-                        );
-                        visit(slot + 1, room + q[i], Dep::X(&[(r, a)]));
+                        visit(slot, room - qi, Dep::X(&[(r, crate::geom::scale(a, -1.0))]));
+                        visit(slot + 1, room + qi, Dep::X(&[(r, a)]));
                         slot += 2;
                     }
                 }

@@ -76,8 +76,8 @@ impl Convex {
             Hull::Box(b) => {
                 let q = b.local(c);
                 let mut s = 0.0;
-                for i in 0..3 {
-                    let e = q[i].abs() - b.half[i];
+                for (qi, hi) in q.iter().zip(b.half) {
+                    let e = qi.abs() - hi;
                     if e > 0.0 {
                         s += e * e;
                     }
