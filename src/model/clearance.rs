@@ -28,40 +28,46 @@
 //!   their sides (`±n·(x − apex) ≥ 0`, smooth where the angular form has a kink);
 //! - facets sharing a crease: its fold angle stays `2 asin(G/2)` short of ±π (the model's
 //!   crease constraints, not here);
-//! - a facet and a cylinder ([`PairKind::Obstacle`]): the facet clear of the capsule of
-//!   radius `r + obstacle_clearance` around the axis segment (the finite cylinder lies
-//!   inside it: conservative): the facet's vertices at `n·x ≥ d`, both axis ends at
-//!   `n·x ≤ d − (r + obstacle_clearance)`.
+//! - a facet and a convex obstacle piece ([`PairKind::Obstacle`], see [`obstacle`]): its
+//!   support points inflated by a radius (a cylinder: the capsule of radius
+//!   `r + obstacle_clearance` around the axis segment, which contains the finite cylinder;
+//!   a sphere: its centre; a box: its corners; a mesh: each triangle): the facet's
+//!   vertices at `n·x ≥ d`, the piece's points at `n·x ≤ d − (r + obstacle_clearance)`.
+//!
+//! With `n` copies of the arm (issue 31), the arm is kept clear of copies `1..=n/2` (the
+//! pair of copies i and j is the arm and copy `j − i` turned) and every copy's facets of
+//! every obstacle piece the copy's rotation does not map onto itself.
 //!
 //! Scaling: with `F` facets there are `O(F²)` pairs (doubled for the rotated copy of a
 //! two-armed task, halved again by its symmetry) and each contributes one constraint per
 //! vertex of its two facets at each sampled state. Far pairs cost only a bounding-sphere
 //! test per state: they get no plane and no constraints until they come within reach.
 
+pub mod copies;
+pub mod obstacle;
+
+pub use copies::{CopyMap, copy_point};
+pub use obstacle::Convex;
+
 use crate::geom::{V3, add, cross, dot, norm, scale, sub};
 use crate::model::plan::{Plan, Position};
-use crate::task::Cylinder;
 
-/// The rotated copy of a two-armed task: 180° about the z-axis.
-pub fn copy_point(p: V3) -> V3 {
-    [-p[0], -p[1], p[2]]
-}
-
-/// A vertex of the arm (`copy = false`) or of its rotated copy.
+/// A vertex of the arm (`copy = 0`) or of one of its rotated copies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct VRef {
     /// Dense vertex index of the arm.
     pub vertex: usize,
-    /// Whether it is the rotated copy's vertex.
-    pub copy: bool,
+    /// Which copy: 0 the arm, `k` the arm turned by `2πk/n`.
+    pub copy: usize,
 }
 
 /// The positions of one state: the arm's vertices, their copies, and a bounding sphere of
-/// every facet (arm, then copy).
+/// every facet (arm, then each copy).
 #[derive(Clone, Debug, Default)]
 pub struct Scene {
     /// Arm vertex positions.
     pub x: Vec<V3>,
+    /// Copy k's vertices at `(k − 1)·n_vertices..`.
     copies: Vec<V3>,
     spheres: Vec<(V3, f64)>,
 }
@@ -69,10 +75,13 @@ pub struct Scene {
 impl Scene {
     /// Refill from the arm's vertex positions.
     pub fn set(&mut self, x: &[V3], pairs: &Pairs) {
+        let map = &pairs.copies;
         self.x.clear();
         self.x.extend_from_slice(x);
         self.copies.clear();
-        self.copies.extend(x.iter().map(|p| copy_point(*p)));
+        for k in 1..map.n() {
+            self.copies.extend(x.iter().map(|p| map.point(k, *p)));
+        }
         self.spheres.clear();
         for (_, vs) in &pairs.facets {
             let c = scale(
@@ -83,23 +92,26 @@ impl Scene {
             self.spheres.push((c, r));
         }
         let n = self.spheres.len();
-        for k in 0..n {
-            let (c, r) = self.spheres[k];
-            self.spheres.push((copy_point(c), r));
+        for k in 1..map.n() {
+            for f in 0..n {
+                let (c, r) = self.spheres[f];
+                self.spheres.push((map.point(k, c), r));
+            }
         }
     }
 
     /// Position of a vertex reference.
     pub fn at(&self, r: VRef) -> V3 {
-        if r.copy {
-            self.copies[r.vertex]
-        } else {
+        if r.copy == 0 {
             self.x[r.vertex]
+        } else {
+            self.copies[(r.copy - 1) * self.x.len() + r.vertex]
         }
     }
 
-    fn sphere(&self, facet: usize, copy: bool, n_facets: usize) -> (V3, f64) {
-        self.spheres[facet + if copy { n_facets } else { 0 }]
+    /// The bounding sphere of facet `facet` (index into [`Pairs::facets`]) of copy `copy`.
+    pub fn sphere(&self, facet: usize, copy: usize, n_facets: usize) -> (V3, f64) {
+        self.spheres[facet + copy * n_facets]
     }
 }
 
@@ -108,7 +120,7 @@ impl Scene {
 pub enum Group {
     /// Two facets of the arm.
     SelfPair,
-    /// A facet of the arm and one of its rotated copy.
+    /// A facet of the arm and one of a rotated copy.
     Arm,
     /// A facet and an obstacle.
     Obstacle,
@@ -126,20 +138,22 @@ pub enum PairKind {
         /// The other.
         b: VRef,
     },
-    /// Facet and the capsule of cylinder `k`.
+    /// Facet and convex obstacle piece `k` ([`Pairs::obstacles`]), inflated by its radius.
     Obstacle {
-        /// Index of the cylinder.
+        /// Index of the piece.
         k: usize,
+        /// Number of its support points.
+        points: usize,
     },
 }
 
 /// A pair of pieces with its constraint slots.
 #[derive(Clone, Debug)]
 pub struct Pair {
-    /// Index into [`Pairs::facets`] of the first piece and whether it is the copy's.
-    pub a: (usize, bool),
+    /// Index into [`Pairs::facets`] of the first piece and which copy it is on.
+    pub a: (usize, usize),
     /// The second facet (`None` for an obstacle).
-    pub b: Option<(usize, bool)>,
+    pub b: Option<(usize, usize)>,
     /// Kind of separation.
     pub kind: PairKind,
     /// Which clearance it counts toward.
@@ -149,7 +163,7 @@ pub struct Pair {
     /// Vertices of the second piece.
     pub b_verts: Vec<VRef>,
     /// Index of the pair's first slot: one per vertex of A, then of B (for an obstacle,
-    /// its two axis ends).
+    /// one per support point: a cylinder's two axis ends).
     pub slot: usize,
 }
 
@@ -158,7 +172,7 @@ impl Pair {
     pub fn slots(&self) -> usize {
         self.a_verts.len()
             + match self.kind {
-                PairKind::Obstacle { .. } => 2,
+                PairKind::Obstacle { points, .. } => points,
                 _ => self.b_verts.len(),
             }
     }
@@ -169,7 +183,7 @@ impl Pair {
     }
 
     /// How much of the gap `g` each side needs from the plane: half each between facets,
-    /// all of it on the cylinder's side.
+    /// all of it on the obstacle's side.
     fn sides(&self, g: f64) -> (f64, f64) {
         match self.kind {
             PairKind::Obstacle { .. } => (0.0, g),
@@ -204,46 +218,32 @@ pub struct Pairs {
     pub pairs: Vec<Pair>,
     /// Total number of slots.
     pub slots: usize,
-    /// The obstacles.
-    pub cylinders: Vec<Cylinder>,
-}
-
-/// Whether fixed flat positions `p` and `q` coincide after the copy's rotation.
-fn merges(p: [f64; 2], q: [f64; 2]) -> bool {
-    (-p[0] - q[0]).hypot(-p[1] - q[1]) <= 1e-9
+    /// The convex obstacle pieces.
+    pub obstacles: Vec<Convex>,
+    /// The copies of the arm.
+    pub copies: CopyMap,
 }
 
 /// An arm vertex.
 fn arm(v: usize) -> VRef {
-    VRef {
-        vertex: v,
-        copy: false,
-    }
-}
-
-/// A vertex of the rotated copy.
-fn cpy(v: usize) -> VRef {
-    VRef {
-        vertex: v,
-        copy: true,
-    }
+    VRef { vertex: v, copy: 0 }
 }
 
 /// The vertices `vs` but `skip`, as references by `r`.
-fn without(vs: &[usize], skip: usize, r: fn(usize) -> VRef) -> Vec<VRef> {
+fn without(vs: &[usize], skip: usize, r: impl Fn(usize) -> VRef) -> Vec<VRef> {
     vs.iter().copied().filter(|u| *u != skip).map(r).collect()
 }
 
-/// The arm vertex that the copy of vertex `j` coincides with, if any: both are fixed and
-/// the rotation maps one onto the other (v1 at the origin for the gripper), so the two
-/// arms share it, as in `check::two_armed`.
-fn copy_is(plan: &Plan, j: usize) -> Option<usize> {
+/// The arm vertex that copy `k` of vertex `j` coincides with, if any: both are fixed and
+/// the rotation maps one onto the other (v1 at the origin for the gripper), so the arms
+/// share it, as in `check::two_armed`.
+fn copy_is(plan: &Plan, map: &CopyMap, k: usize, j: usize) -> Option<usize> {
     let fixed = |v: usize| match plan.vertices[v].position {
         Position::Fixed(p) => Some(p),
         Position::Placed { .. } | Position::Between { .. } => None,
     };
     let q = fixed(j)?;
-    (0..plan.vertices.len()).find(|&i| fixed(i).is_some_and(|p| merges(q, p)))
+    (0..plan.vertices.len()).find(|&i| fixed(i).is_some_and(|p| map.merges(k, q, p)))
 }
 
 /// The pairs built so far and the next free slot.
@@ -255,8 +255,8 @@ struct PairList {
 impl PairList {
     fn push(
         &mut self,
-        a: (usize, bool),
-        b: Option<(usize, bool)>,
+        a: (usize, usize),
+        b: Option<(usize, usize)>,
         kind: PairKind,
         group: Group,
         a_verts: Vec<VRef>,
@@ -282,16 +282,16 @@ impl PairList {
                 let shared: Vec<usize> = va.iter().copied().filter(|v| vb.contains(v)).collect();
                 match shared.as_slice() {
                     [] => self.push(
-                        (i, false),
-                        Some((j, false)),
+                        (i, 0),
+                        Some((j, 0)),
                         PairKind::Apart,
                         Group::SelfPair,
                         va.iter().map(|v| arm(*v)).collect(),
                         vb.iter().map(|v| arm(*v)).collect(),
                     ),
                     [v] => self.push(
-                        (i, false),
-                        Some((j, false)),
+                        (i, 0),
+                        Some((j, 0)),
                         PairKind::Cone {
                             a: arm(*v),
                             b: arm(*v),
@@ -309,21 +309,35 @@ impl PairList {
         }
     }
 
-    /// The pairs of an arm facet and a facet of the rotated copy (whose tips meet when
-    /// `tip`, the gripping vertex, is given).
-    fn arm_pairs(&mut self, plan: &Plan, facets: &[(usize, Vec<usize>)], tip: Option<usize>) {
-        // (f, copy g) and (g, copy f) are the same pair turned by 180°: keep f ≤ g.
+    /// The pairs of an arm facet and a facet of copy `k` (whose tips meet when `tip`, the
+    /// gripping vertex, is given).
+    fn arm_pairs(
+        &mut self,
+        plan: &Plan,
+        map: &CopyMap,
+        k: usize,
+        facets: &[(usize, Vec<usize>)],
+        tip: Option<usize>,
+    ) {
+        let cpy = |v: usize| VRef { vertex: v, copy: k };
+        // For the half turn (k = n/2), (f, copy g) and (g, copy f) are the same pair turned:
+        // keep f ≤ g. Other turns pair every f with every g.
+        let half = 2 * k == map.n();
         for (i, (_, va)) in facets.iter().enumerate() {
-            for (j, (_, vb)) in facets.iter().enumerate().skip(i) {
+            for (j, (_, vb)) in facets.iter().enumerate().skip(if half { i } else { 0 }) {
                 let shared: Vec<(usize, usize)> = vb
                     .iter()
-                    .filter_map(|&q| copy_is(plan, q).filter(|a| va.contains(a)).map(|a| (a, q)))
+                    .filter_map(|&q| {
+                        copy_is(plan, map, k, q)
+                            .filter(|a| va.contains(a))
+                            .map(|a| (a, q))
+                    })
                     .collect();
                 let tips = tip.filter(|g| va.contains(g) && vb.contains(g));
                 match (shared.as_slice(), tips) {
                     ([], None) => self.push(
-                        (i, false),
-                        Some((j, true)),
+                        (i, 0),
+                        Some((j, k)),
                         PairKind::Apart,
                         Group::Arm,
                         va.iter().map(|v| arm(*v)).collect(),
@@ -332,8 +346,8 @@ impl PairList {
                     // The tips stay in the lists: each keeps to its side of the plane
                     // (see `constraints`), or the facets cross within the tips' offset.
                     ([], Some(g)) => self.push(
-                        (i, false),
-                        Some((j, true)),
+                        (i, 0),
+                        Some((j, k)),
                         PairKind::Cone {
                             a: arm(g),
                             b: cpy(g),
@@ -343,8 +357,8 @@ impl PairList {
                         vb.iter().map(|v| cpy(*v)).collect(),
                     ),
                     ([(a, q)], None) => self.push(
-                        (i, false),
-                        Some((j, true)),
+                        (i, 0),
+                        Some((j, k)),
                         PairKind::Cone {
                             a: arm(*a),
                             b: arm(*a),
@@ -361,29 +375,26 @@ impl PairList {
         }
     }
 
-    /// The pairs of a facet and a cylinder.
+    /// The pairs of a facet of every copy and every convex obstacle piece.
     fn obstacle_pairs(
         &mut self,
         facets: &[(usize, Vec<usize>)],
-        cylinders: &[Cylinder],
-        second_arm: bool,
+        obstacles: &[Convex],
+        map: &CopyMap,
     ) {
-        for (k, cyl) in cylinders.iter().enumerate() {
-            // The copy's facets only need their own pairs when the cylinder is not mapped
-            // onto itself by the rotation.
-            let symmetric = {
-                let (a, b) = (copy_point(cyl.a), copy_point(cyl.b));
-                (a == cyl.a && b == cyl.b) || (a == cyl.b && b == cyl.a)
-            };
-            for copy in [false, true] {
-                if copy && (!second_arm || symmetric) {
+        for (k, piece) in obstacles.iter().enumerate() {
+            let points = piece.points.len();
+            for copy in 0..map.n() {
+                // A copy's facets only need their own pairs when the piece is not mapped
+                // onto itself by the copy's rotation.
+                if copy > 0 && piece.symmetric(|p| map.point(copy, p), map.tolerance()) {
                     continue;
                 }
                 for (i, (_, vs)) in facets.iter().enumerate() {
                     self.push(
                         (i, copy),
                         None,
-                        PairKind::Obstacle { k },
+                        PairKind::Obstacle { k, points },
                         Group::Obstacle,
                         vs.iter().map(|v| VRef { vertex: *v, copy }).collect(),
                         Vec::new(),
@@ -395,10 +406,10 @@ impl PairList {
 }
 
 impl Pairs {
-    /// The pairs of `plan`: arm facets among themselves, with the rotated copy when
-    /// `second_arm` (whose tips meet when `tip`, the gripping vertex, is given), and with
-    /// every cylinder.
-    pub fn new(plan: &Plan, second_arm: bool, tip: Option<usize>, cylinders: &[Cylinder]) -> Pairs {
+    /// The pairs of `plan`: arm facets among themselves, with copies `1..=n/2` (the others
+    /// are the same pairs turned; the tips of all copies meet when `tip`, the gripping
+    /// vertex, is given), and of every copy's facets with every obstacle piece.
+    pub fn new(plan: &Plan, copies: CopyMap, tip: Option<usize>, obstacles: Vec<Convex>) -> Pairs {
         let facets: Vec<(usize, Vec<usize>)> = plan
             .polygons
             .iter()
@@ -411,21 +422,24 @@ impl Pairs {
             slot: 0,
         };
         list.self_pairs(&facets);
-        if second_arm {
-            list.arm_pairs(plan, &facets, tip);
+        for k in 1..=copies.n() / 2 {
+            list.arm_pairs(plan, &copies, k, &facets, tip);
         }
-        list.obstacle_pairs(&facets, cylinders, second_arm);
+        list.obstacle_pairs(&facets, &obstacles, &copies);
         Pairs {
             facets,
             pairs: list.pairs,
             slots: list.slot,
-            cylinders: cylinders.to_vec(),
+            obstacles,
+            copies,
         }
     }
 
     /// A lower bound on the distance between the pieces of `pair` (bounding spheres), or on
     /// the angle between their cones at the apex.
-    pub fn lower_bound(&self, pair: &Pair, s: &Scene, buf: &mut Buffers) -> f64 {
+    /// A mesh triangle whose bounding ball is farther than `cull` gets that ball's distance
+    /// (still a lower bound) without the exact distance.
+    pub fn lower_bound(&self, pair: &Pair, s: &Scene, cull: f64, buf: &mut Buffers) -> f64 {
         let nf = self.facets.len();
         match pair.kind {
             PairKind::Cone { .. } => {
@@ -453,18 +467,18 @@ impl Pairs {
                     _ => f64::NEG_INFINITY,
                 }
             }
-            PairKind::Obstacle { k } => {
+            PairKind::Obstacle { k, .. } => {
                 let (c, r) = s.sphere(pair.a.0, pair.a.1, nf);
-                let cyl = &self.cylinders[k];
-                // Distance from the centre to the axis segment.
-                let ab = sub(cyl.b, cyl.a);
-                let l = dot(ab, ab);
-                let u = if l > 0.0 {
-                    (dot(sub(c, cyl.a), ab) / l).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                norm(sub(c, add(cyl.a, scale(ab, u)))) - r
+                let piece = &self.obstacles[k];
+                // A mesh's triangles are many: their balls first, the exact distance only
+                // for those within reach.
+                if piece.hull == obstacle::Hull::Triangle {
+                    let far = norm(sub(c, piece.ball.0)) - piece.ball.1 - r;
+                    if far > cull {
+                        return far;
+                    }
+                }
+                piece.distance(c) - r
             }
             PairKind::Apart => {
                 let (ca, ra) = s.sphere(pair.a.0, pair.a.1, nf);
@@ -491,13 +505,13 @@ pub struct Buffers {
 
 /// Fill `buf` with the points of `pair`'s pieces (A's vertices; B's, or the axis ends) and,
 /// for cones, the directions from the apex (A's, then B's reversed).
-fn points(pair: &Pair, s: &Scene, cyl: &[Cylinder], buf: &mut Buffers) -> V3 {
+fn points(pair: &Pair, s: &Scene, obstacles: &[Convex], buf: &mut Buffers) -> V3 {
     buf.a.clear();
     buf.b.clear();
     buf.u.clear();
     buf.a.extend(pair.a_verts.iter().map(|r| s.at(*r)));
     match pair.kind {
-        PairKind::Obstacle { k } => buf.b.extend([cyl[k].a, cyl[k].b]),
+        PairKind::Obstacle { k, .. } => buf.b.extend_from_slice(&obstacles[k].points),
         _ => buf.b.extend(pair.b_verts.iter().map(|r| s.at(*r))),
     }
     let apex = pair.apex(s);
@@ -701,13 +715,13 @@ pub struct Effort {
 pub fn fit_plane(
     pair: &Pair,
     s: &Scene,
-    cyl: &[Cylinder],
+    obstacles: &[Convex],
     previous: Option<Plane>,
     need: f64,
     effort: Effort,
     buf: &mut Buffers,
 ) -> (Plane, f64) {
-    let apex = points(pair, s, cyl, buf);
+    let apex = points(pair, s, obstacles, buf);
     let buf = &*buf;
     // The offset that leaves both sides the same slack over what they need.
     let offset = |n: V3| {
@@ -826,13 +840,13 @@ pub struct Slot<'a> {
 }
 
 /// Visit every constraint of `pair` with plane `plane` in scene `s` for the required gap
-/// `gap` (the cylinder's axis ends taken from `cyl`).
+/// `gap` (an obstacle piece's support points taken from `obstacles`).
 pub fn constraints(
     pair: &Pair,
     plane: &Plane,
     gap: f64,
     s: &Scene,
-    cyl: &[Cylinder],
+    obstacles: &[Convex],
     mut visit: impl FnMut(Slot<'_>),
 ) {
     let n = plane.n;
@@ -851,8 +865,8 @@ pub fn constraints(
             }
             let m = scale(n, -1.0);
             let base = pair.slot + pair.a_verts.len();
-            if let PairKind::Obstacle { k } = pair.kind {
-                for (j, p) in [cyl[k].a, cyl[k].b].into_iter().enumerate() {
+            if let PairKind::Obstacle { k, .. } = pair.kind {
+                for (j, p) in obstacles[k].points.iter().copied().enumerate() {
                     visit(Slot {
                         slot: base + j,
                         h: plane.d - dot(n, p) - gb,

@@ -22,9 +22,13 @@
 //!
 //! ## The constraints, at each sampled state t
 //!
-//! - clearance between facets, to the rotated copy and to the cylinders
+//! - clearance between facets, to the rotated copies and to the obstacles' convex pieces
 //!   ([`super::clearance`]);
-//! - creases stay `2 asin(clearance/2)` short of folding flat (|ρ| ≤ π − that);
+//! - every vertex of every copy above each half-space obstacle and inside each containment
+//!   box (at its one t, a sampled state of every start, or at every state), with
+//!   `obstacle_clearance` to the walls: linear in the positions, no plane;
+//! - creases stay `2 asin(clearance/2)` short of folding flat (|ρ| ≤ π − that), and
+//!   within the task's fold limits (`max_fold`, `fold_limits`) where those are lower;
 //! - rigid foldability with margin: `U_j + U_k − U_i ≥ rigid_margin · (t/t_max)²` for
 //!   t > 0. At the flat state every vertex whose first unit spans more than π has a
 //!   degenerate vertex triangle (`U_1 = 2π − Σα = U_2 + U_3` by developability, for any
@@ -52,14 +56,19 @@
 //! setting; a design is accepted only when a finer sweep (the search's verification
 //! sweep) holds with half that safety, and states where it does not are added.
 
-use super::clearance::{self, Buffers, Effort, Group, Pair, PairKind, Pairs, Plane, Scene, VRef};
+use super::clearance::{
+    self, Buffers, CopyMap, Effort, Group, Pair, PairKind, Pairs, Plane, Scene, VRef, obstacle,
+};
+use super::select::{self, SelectError};
 use super::{Model, RIGID_MARGIN, geometry};
 use crate::compile::{self, Compiled, Options};
 use crate::expr::{Ctx, Sym};
 use crate::geom::V3;
 use crate::kinematics::{Scalar, wrap_angle};
 use crate::optimize::{Acceptance, Robust};
-use crate::task::{Cylinder, Robustness, Task};
+use crate::scene::{Containment, HalfSpace};
+use crate::task::terms::Requirements;
+use crate::task::{Robustness, Task};
 use std::cell::{Cell, OnceCell, RefCell};
 use std::f64::consts::PI;
 use std::sync::OnceLock;
@@ -72,7 +81,7 @@ pub const SAFETY: f64 = 1e-2;
 pub const CLEARANCE_FLOOR: f64 = 1e-6;
 /// Pairs whose bounding spheres are farther apart than the required gap plus this (paper
 /// units; radians for cones) get no plane.
-const ACTIVATE: f64 = 0.05;
+pub const ACTIVATE: f64 = 0.05;
 /// A sampled state joins the merit while one of its constraints is within this of its
 /// bound (or carries a multiplier).
 const LIVE: f64 = 0.05;
@@ -103,10 +112,12 @@ pub struct RobustSpec {
     pub states: usize,
     /// States of the finer sweep a design must also pass.
     pub sweep: usize,
-    /// Two-armed task: the rotated copy is kept clear of the arm.
-    pub second_arm: bool,
-    /// Obstacles.
-    pub cylinders: Vec<Cylinder>,
+    /// The world: obstacles of every shape (kept clear by every copy), the copies (kept
+    /// clear of each other), the containment boxes.
+    pub scene: crate::scene::Scene,
+    /// The task's requirements; the block reads the fold-angle limits (`max_fold`,
+    /// `fold_limits`).
+    pub requirements: Requirements,
 }
 
 impl RobustSpec {
@@ -117,10 +128,21 @@ impl RobustSpec {
             settings: task.robustness,
             states: check.map_or(crate::task::DEFAULT_OPTIMIZE_STATES, |c| c.optimize_states),
             sweep: sweep.max(2),
-            second_arm: task.scene.copies.n == 2,
-            cylinders: task.scene.cylinders().copied().collect(),
+            scene: task.scene.clone(),
+            requirements: task.requirements.clone(),
         }
     }
+}
+
+/// Why a block could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    /// Code generation failed.
+    #[error(transparent)]
+    Compile(#[from] compile::CompileError),
+    /// A fold limit names a crease this graph does not have.
+    #[error("fold limit: {0}")]
+    Select(#[from] SelectError),
 }
 
 /// How strictly a requirement is read.
@@ -154,6 +176,39 @@ pub enum Dep<'a> {
     Margin(usize),
     /// Fold angle of crease `creases[c]` with `∂h/∂ρ`.
     Rho(usize, f64),
+}
+
+/// What a constraint slot of [`RobustModel::slots`] belongs to (for messages and records).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SlotOwner {
+    /// A clearance pair (index into the pairs).
+    Pair(usize),
+    /// The fold angle of `creases[c]`.
+    Crease(usize),
+    /// Margin `k` of the Eq. 25 margins (vertex `k / 3`).
+    Margin(usize),
+    /// Vertex `vertex` of copy `copy` above half-space `k` (index into
+    /// [`RobustModel::halfspaces`]).
+    HalfSpace {
+        /// Which half-space.
+        k: usize,
+        /// Which copy.
+        copy: usize,
+        /// Which vertex.
+        vertex: usize,
+    },
+    /// Vertex `vertex` of copy `copy` inside box `k` (index into [`RobustModel::boxes`]),
+    /// against wall `wall`: `2i` the `+` wall of the box's axis `i`, `2i + 1` the `−` wall.
+    Box {
+        /// Which box.
+        k: usize,
+        /// Which copy.
+        copy: usize,
+        /// Which vertex.
+        vertex: usize,
+        /// Which wall.
+        wall: usize,
+    },
 }
 
 /// The values the block reads at one state.
@@ -190,6 +245,13 @@ pub struct RobustModel {
     pub pairs: Pairs,
     /// Creases with a fold-angle constraint (the driven ones are set by the task).
     pub creases: Vec<usize>,
+    /// The task's fold-angle limit of each of [`RobustModel::creases`] (rad; `None`: only
+    /// the clearance's distance from ±π).
+    pub fold_limits: Vec<Option<f64>>,
+    /// The half-space obstacles: (index in the scene, the half-space).
+    pub halfspaces: Vec<(usize, HalfSpace)>,
+    /// The containment boxes.
+    pub boxes: Vec<Containment>,
     /// Settings.
     pub spec: RobustSpec,
     /// The flat layout's edges: every crease (tail, head), then the paper's edges that
@@ -208,20 +270,20 @@ pub struct RobustModel {
 
 impl RobustModel {
     /// Build and compile the block of `model`.
-    pub fn new(model: &Model, spec: RobustSpec) -> Result<RobustModel, compile::CompileError> {
+    pub fn new(model: &Model, spec: RobustSpec) -> Result<RobustModel, BuildError> {
         let start = Instant::now();
         let plan = &model.plan;
-        // The two arms of a gripper meet at its target: their tips touch there by design.
-        let tip = (spec.second_arm
-            && model
-                .targets
-                .iter()
-                .any(|t| t.point[0].abs() < 1e-9 && t.point[1].abs() < 1e-9))
-        .then_some(model.gripping);
-        let pairs = Pairs::new(plan, spec.second_arm, tip, &spec.cylinders);
+        let map = CopyMap::new(spec.scene.copies);
+        // The arms of a gripper meet at its target on the axis: their tips touch there by
+        // design.
+        let tip = (map.n() >= 2 && model.targets.iter().any(|t| map.on_axis(t.point)))
+            .then_some(model.gripping);
+        let (convex, halfspaces) = obstacle::pieces(&spec.scene);
+        let pairs = Pairs::new(plan, map, tip, convex);
         let creases: Vec<usize> = (0..plan.creases.len())
             .filter(|&c| plan.creases[c].drive.is_none())
             .collect();
+        let fold_limits = resolve_fold_limits(model, &creases, &spec.requirements)?;
         let (nv, ni, nf, nc) = (
             plan.vertices.len(),
             plan.internal.len(),
@@ -283,6 +345,9 @@ impl RobustModel {
         Ok(RobustModel {
             pairs,
             creases,
+            fold_limits,
+            halfspaces,
+            boxes: spec.scene.containment.clone(),
             spec,
             edges: layout_edges(plan),
             values,
@@ -296,9 +361,113 @@ impl RobustModel {
     }
 
     /// Number of constraint slots per state: the pairs', then one per crease, then three
-    /// margins per internal vertex.
+    /// margins per internal vertex, then one per half-space, copy and vertex, then six per
+    /// box, copy and vertex.
     pub fn slots(&self) -> usize {
+        self.scene_base() + self.scene_slots()
+    }
+
+    /// The first half-space slot.
+    fn scene_base(&self) -> usize {
         self.pairs.slots + self.creases.len() + 3 * self.n_internal
+    }
+
+    /// Number of half-space and box slots.
+    fn scene_slots(&self) -> usize {
+        let per = self.pairs.copies.n() * self.n_vertices;
+        per * (self.halfspaces.len() + 6 * self.boxes.len())
+    }
+
+    /// What slot `slot` (< [`RobustModel::slots`]) constrains.
+    pub fn slot_owner(&self, slot: usize) -> SlotOwner {
+        let pairs = &self.pairs.pairs;
+        if slot < self.pairs.slots {
+            // Pairs' slots are consecutive, in order.
+            let p = pairs.partition_point(|q| q.slot + q.slots() <= slot);
+            return SlotOwner::Pair(p);
+        }
+        let mut s = slot - self.pairs.slots;
+        if s < self.creases.len() {
+            return SlotOwner::Crease(s);
+        }
+        s -= self.creases.len();
+        if s < 3 * self.n_internal {
+            return SlotOwner::Margin(s);
+        }
+        s -= 3 * self.n_internal;
+        let nv = self.n_vertices;
+        let per = self.pairs.copies.n() * nv;
+        if s < per * self.halfspaces.len() {
+            let (k, r) = (s / per, s % per);
+            return SlotOwner::HalfSpace {
+                k,
+                copy: r / nv,
+                vertex: r % nv,
+            };
+        }
+        s -= per * self.halfspaces.len();
+        let (k, r) = (s / (6 * per), s % (6 * per));
+        SlotOwner::Box {
+            k,
+            copy: r / (6 * nv),
+            vertex: (r / 6) % nv,
+            wall: r % 6,
+        }
+    }
+
+    /// A label for slot `slot`: the obstacle's or box's name, the copy and the vertex, or
+    /// the crease, margin or pair.
+    pub fn slot_label(&self, slot: usize) -> String {
+        let scene = &self.spec.scene;
+        match self.slot_owner(slot) {
+            SlotOwner::Pair(p) => {
+                let pair = &self.pairs.pairs[p];
+                match pair.kind {
+                    PairKind::Obstacle { k, .. } => {
+                        let o = self.pairs.obstacles[k].obstacle;
+                        format!(
+                            "{} (copy {}, facet {})",
+                            scene.obstacles[o].name, pair.a.1, pair.a.0
+                        )
+                    }
+                    _ => format!("{:?} pair {p}", pair.group),
+                }
+            }
+            SlotOwner::Crease(c) => format!("fold angle of crease {}", self.creases[c]),
+            SlotOwner::Margin(k) => format!("margin {} of internal vertex {}", k % 3, k / 3),
+            SlotOwner::HalfSpace { k, copy, vertex } => format!(
+                "{} (copy {copy}, vertex {vertex})",
+                scene.obstacles[self.halfspaces[k].0].name
+            ),
+            SlotOwner::Box {
+                k,
+                copy,
+                vertex,
+                wall,
+            } => format!(
+                "{} (copy {copy}, vertex {vertex}, {}{} wall)",
+                self.boxes[k].name,
+                if wall % 2 == 0 { "+" } else { "-" },
+                ["x", "y", "z"][wall / 2]
+            ),
+        }
+    }
+
+    /// The states every start samples: `states` evenly spaced over [0, t_max], then the
+    /// t of every box that applies at one state (unless already sampled).
+    pub fn base_times(&self) -> Vec<f64> {
+        let n = self.spec.states.max(2);
+        let mut ts: Vec<f64> = (0..n)
+            .map(|i| self.t_max * i as f64 / (n - 1) as f64)
+            .collect();
+        for b in &self.boxes {
+            if let Some(t) = b.t
+                && !ts.contains(&t)
+            {
+                ts.push(t);
+            }
+        }
+        ts
     }
 
     /// Number of pullback weights (3 per vertex, 3 per internal vertex, 1 per crease).
@@ -412,8 +581,8 @@ impl RobustModel {
             _ => CLEARANCE_FLOOR,
         };
         match pair.kind {
-            PairKind::Obstacle { k: c } => {
-                self.spec.cylinders[c].radius + s.obstacle_clearance * k + floor
+            PairKind::Obstacle { k: c, .. } => {
+                self.pairs.obstacles[c].radius + s.obstacle_clearance * k + floor
             }
             _ => s.clearance * k + floor,
         }
@@ -427,6 +596,32 @@ impl RobustModel {
             _ => CLEARANCE_FLOOR,
         };
         2.0 * ((s.clearance * level.factor()).min(2.0) / 2.0).asin() + floor
+    }
+
+    /// The largest `|ρ|` crease `creases[c]` may reach at `level` (rad): `π −`
+    /// [`RobustModel::crease_gap`], lowered to the task's fold limit (with the safety).
+    pub fn crease_limit(&self, c: usize, level: Level) -> f64 {
+        let lim = PI - self.crease_gap(level);
+        match self.fold_limits[c] {
+            None => lim,
+            Some(m) => {
+                let floor = match level {
+                    Level::Setting => 0.0,
+                    _ => CLEARANCE_FLOOR,
+                };
+                lim.min(m / level.factor() - floor)
+            }
+        }
+    }
+
+    /// The distance every vertex keeps from a half-space's boundary and a box's walls at
+    /// `level` (paper units).
+    pub fn wall_gap(&self, level: Level) -> f64 {
+        let floor = match level {
+            Level::Setting => 0.0,
+            _ => CLEARANCE_FLOOR,
+        };
+        self.spec.settings.obstacle_clearance * level.factor() + floor
     }
 
     /// The margin every vertex keeps at `t` (rad), `None` at the flat state.
@@ -472,7 +667,7 @@ impl RobustModel {
     ) {
         let pair = &self.pairs.pairs[p];
         let gap = self.gap(pair, level);
-        clearance::constraints(pair, plane, gap, &v.scene, &self.pairs.cylinders, visit);
+        clearance::constraints(pair, plane, gap, &v.scene, &self.pairs.obstacles, visit);
     }
 
     /// Visit the crease and margin constraints: `visit(slot, h, dep)`.
@@ -487,12 +682,65 @@ impl RobustModel {
         let lim = PI - self.crease_gap(level);
         for (c, rho) in v.rho.iter().enumerate() {
             let w = wrap_angle(*rho);
+            let lim = match self.fold_limits[c] {
+                None => lim,
+                Some(_) => self.crease_limit(c, level),
+            };
             visit(base + c, lim - w.abs(), Dep::Rho(c, -w.signum()));
         }
         if let Some(req) = self.margin_required(t, level) {
             let base = base + self.creases.len();
             for (k, m) in v.margins.iter().enumerate() {
                 visit(base + k, m - req, Dep::Margin(k));
+            }
+        }
+        self.visit_walls(t, v, level, visit);
+    }
+
+    /// Visit the half-space and box constraints at `t` (a box with its own t only there):
+    /// every vertex of every copy keeps `n·(x − p) ≥ g` above each half-space and
+    /// `half_i − g ∓ a_i·(x − c) ≥ 0` inside each box, `g` = [`RobustModel::wall_gap`].
+    pub fn visit_walls(
+        &self,
+        t: f64,
+        v: &StateValues,
+        level: Level,
+        mut visit: impl FnMut(usize, f64, Dep<'_>),
+    ) {
+        if self.halfspaces.is_empty() && self.boxes.is_empty() {
+            return;
+        }
+        let g = self.wall_gap(level);
+        let (n, nv) = (self.pairs.copies.n(), self.n_vertices);
+        let mut slot = self.scene_base();
+        for (_, hs) in &self.halfspaces {
+            for copy in 0..n {
+                for vertex in 0..nv {
+                    let r = VRef { vertex, copy };
+                    let h = hs.height(v.scene.at(r)) - g;
+                    visit(slot, h, Dep::X(&[(r, hs.normal)]));
+                    slot += 1;
+                }
+            }
+        }
+        for b in &self.boxes {
+            if b.t.is_some_and(|tb| tb != t) {
+                slot += 6 * n * nv;
+                continue;
+            }
+            let bounds = &b.bounds;
+            for copy in 0..n {
+                for vertex in 0..nv {
+                    let r = VRef { vertex, copy };
+                    let q = bounds.local(v.scene.at(r));
+                    for (i, qi) in q.into_iter().enumerate() {
+                        let room = bounds.half[i] - g;
+                        let a = bounds.axes[i];
+                        visit(slot, room - qi, Dep::X(&[(r, crate::geom::scale(a, -1.0))]));
+                        visit(slot + 1, room + qi, Dep::X(&[(r, a)]));
+                        slot += 2;
+                    }
+                }
             }
         }
     }
@@ -513,7 +761,12 @@ impl RobustModel {
                 PairKind::Cone { .. } => 2.0 * (self.gap(pair, level).min(2.0) / 2.0).asin(),
                 _ => self.gap(pair, level),
             };
-            if !keep(p) && self.pairs.lower_bound(pair, &v.scene, buffers) > need + ACTIVATE {
+            if !keep(p)
+                && self
+                    .pairs
+                    .lower_bound(pair, &v.scene, need + ACTIVATE, buffers)
+                    > need + ACTIVATE
+            {
                 planes[p] = None;
                 continue;
             }
@@ -527,7 +780,7 @@ impl RobustModel {
             let (plane, _) = clearance::fit_plane(
                 pair,
                 &v.scene,
-                &self.pairs.cylinders,
+                &self.pairs.obstacles,
                 planes[p],
                 self.gap(pair, level),
                 Effort { enough, ..effort },
@@ -699,12 +952,8 @@ impl RobustModel {
         match dep {
             Dep::X(gs) => {
                 for (r, g) in gs {
-                    // The copy is the arm turned by 180° about z: ∂/∂X = R ∂/∂(R X), R = Rᵀ.
-                    let g = if r.copy {
-                        clearance::copy_point(*g)
-                    } else {
-                        *g
-                    };
+                    // Copy k is the arm turned by R: ∂/∂X = Rᵀ ∂/∂(R X).
+                    let g = self.pairs.copies.grad_back(r.copy, *g);
                     for i in 0..3 {
                         w[3 * r.vertex + i] += coeff * g[i];
                     }
@@ -714,6 +963,24 @@ impl RobustModel {
             Dep::Rho(c, d) => w[3 * self.n_vertices + 3 * self.n_internal + c] += coeff * d,
         }
     }
+}
+
+/// The fold limit of each constrained crease: the smallest of `max_fold` and the limits
+/// naming it (resolved on the model's plan with its gripping vertex as the tip). A limit on
+/// a driven crease (its angle is the task's, not the design's) is not the block's.
+fn resolve_fold_limits(
+    model: &Model,
+    creases: &[usize],
+    req: &Requirements,
+) -> Result<Vec<Option<f64>>, SelectError> {
+    let mut limits: Vec<Option<f64>> = vec![req.max_fold; creases.len()];
+    for fl in &req.fold_limits {
+        let c = select::crease(&model.plan, model.gripping, &fl.crease)?;
+        if let Some(i) = creases.iter().position(|k| *k == c) {
+            limits[i] = Some(limits[i].map_or(fl.max, |m| m.min(fl.max)));
+        }
+    }
+    Ok(limits)
 }
 
 /// The flat layout's edges: creases, then the paper's edges that close open facets.
@@ -884,9 +1151,11 @@ impl<'a> RobustProblem<'a> {
 
 impl Robust for RobustProblem<'_> {
     fn reset(&self) {
-        let n = self.block.spec.states.max(2);
-        *self.states.borrow_mut() = (0..n)
-            .map(|i| self.new_state(self.model.t_max * i as f64 / (n - 1) as f64))
+        *self.states.borrow_mut() = self
+            .block
+            .base_times()
+            .into_iter()
+            .map(|t| self.new_state(t))
             .collect();
         *self.feature_lambda.borrow_mut() = vec![0.0; self.block.feature_slots()];
     }
@@ -1034,6 +1303,7 @@ impl Robust for RobustProblem<'_> {
         let mut worst: Vec<(f64, f64)> = Vec::new();
         let mut unwrapped: Option<Vec<f64>> = None;
         let lim = PI - b.crease_gap(Level::Accept);
+        let limited = b.fold_limits.iter().any(Option::is_some);
         for i in 0..n {
             let t = self.model.t_max * i as f64 / (n - 1) as f64;
             b.eval(x, &self.modes, t, &mut work);
@@ -1047,7 +1317,13 @@ impl Robust for RobustProblem<'_> {
                     .map(|(p, r)| p + wrap_angle(r - p))
                     .collect(),
             };
-            if next.iter().any(|r| r.abs() > lim) {
+            if !limited && next.iter().any(|r| r.abs() > lim) {
+                return Acceptance::Rejected;
+            }
+            if limited
+                && (next.iter().enumerate())
+                    .any(|(c, r)| r.abs() > b.crease_limit(c, Level::Accept))
+            {
                 return Acceptance::Rejected;
             }
             unwrapped = Some(next);
@@ -1071,11 +1347,22 @@ impl Robust for RobustProblem<'_> {
                 worst.push((h_min, t));
             }
         }
+        // Boxes that hold at one state, which the sweep need not pass through.
+        for tb in b.boxes.iter().filter_map(|c| c.t) {
+            b.eval(x, &self.modes, tb, &mut work);
+            let mut h_min = f64::INFINITY;
+            b.visit_walls(tb, &work.values, Level::Accept, |_, h, _| {
+                h_min = h_min.min(h)
+            });
+            if h_min < -1e-12 {
+                worst.push((h_min, tb));
+            }
+        }
         if worst.is_empty() {
             return Acceptance::Accepted;
         }
         let mut states = self.states.borrow_mut();
-        let added = states.len().saturating_sub(b.spec.states.max(2));
+        let added = states.len().saturating_sub(b.base_times().len());
         worst.sort_by(|p, q| p.0.total_cmp(&q.0));
         let mut new = 0;
         for (_, t) in worst {
