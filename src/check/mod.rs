@@ -30,13 +30,17 @@
 //! assert!(!bad.self_intersection_free());
 //! ```
 
+pub mod copies;
 pub mod cycle;
 pub mod cylinder;
+pub mod distance;
 pub mod features;
 pub mod motion;
+pub mod requirements;
 pub mod robustness;
 pub mod rotated_copy;
 pub mod self_intersection;
+pub mod shapes;
 pub mod tri_tri;
 pub mod triangulate;
 

@@ -29,10 +29,14 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::cylinder::Cylinder;
+use super::distance::point_segment_distance;
+pub use super::distance::{segment_triangle_distance, triangle_distance};
 use super::features::{self, FeatureKind};
 use super::self_intersection::{CheckError, Checker};
-use super::tri_tri::{Tri, triangles_intersect};
+use super::shapes::facet_clearance;
+use super::tri_tri::Tri;
 use crate::pattern::{Frame, Pattern};
+use crate::scene::{Obstacle, Shape};
 use crate::task::{DEFAULT_CLEARANCE, DEFAULT_MIN_FEATURE, DEFAULT_RIGID_MARGIN, Robustness};
 
 type V = Vector3<f64>;
@@ -131,7 +135,8 @@ pub struct RobustnessInput<'a> {
 enum Relation {
     Apart,
     Wedge(usize),
-    Tip,
+    /// The facets of two tips meeting at the target: the arm's vertex and its copy's.
+    Tip(usize, usize),
     Crease(usize),
 }
 
@@ -170,12 +175,37 @@ impl Least {
     }
 }
 
+/// What [`measure`] does not know of a task's scene (issue 31): obstacles of every shape
+/// and the tips of n copies. The default adds nothing: [`measure`] is
+/// `measure_scene(input, &SceneMargins::default())`.
+#[derive(Clone, Debug, Default)]
+pub struct SceneMargins<'a> {
+    /// Obstacles judged by [`super::shapes::facet_clearance`] besides `input.cylinders`
+    /// (pass the scene's obstacles: its cylinders are skipped here, they are the
+    /// `cylinders`' and keep today's arithmetic).
+    pub obstacles: &'a [Obstacle],
+    /// For n copies whose tips meet on the axis: the arm's gripping vertex and its copy in
+    /// each further copy (pattern indices), as `input.tip` is for the half-turn copy.
+    pub tips: Vec<(usize, usize)>,
+}
+
 /// Measure the robustness of the motion in `input.pattern` (see the module docs).
 pub fn measure(input: &RobustnessInput<'_>) -> Result<RobustnessReport, CheckError> {
+    measure_scene(input, &SceneMargins::default())
+}
+
+/// [`measure`] with the scene's other obstacles and copies' tips: the obstacle clearance
+/// is the least over the cylinders and every other shape; face pairs between the arm and
+/// every copy (`input.pattern` holds the arm's facets, then each copy's, as
+/// [`super::copies::with_copies`] builds it) count as `arm_clearance`.
+pub fn measure_scene(
+    input: &RobustnessInput<'_>,
+    scene: &SceneMargins<'_>,
+) -> Result<RobustnessReport, CheckError> {
     let pat = input.pattern;
     let checker = Checker::from_pattern(pat)?;
     let names = Names { input };
-    let pairs = face_pairs(input, &checker);
+    let pairs = face_pairs(input, &checker, &scene.tips);
     let mut least = Leasts {
         rigid: Least::new(),
         own: Least::new(),
@@ -203,6 +233,7 @@ pub fn measure(input: &RobustnessInput<'_>) -> Result<RobustnessReport, CheckErr
             state.pair_clearance(fa, fb, rel, least);
         }
         state.obstacle_clearances(input.cylinders, &mut least.obstacle);
+        state.shape_clearances(scene.obstacles, &mut least.obstacle);
     }
     Ok(report(input, least, &names))
 }
@@ -254,7 +285,7 @@ impl Names<'_, '_> {
         let input = self.input;
         if f < input.arm_faces {
             input.face_names.get(f).cloned().unwrap_or(format!("#{f}"))
-        } else {
+        } else if f < 2 * input.arm_faces {
             format!(
                 "{}′",
                 input
@@ -263,6 +294,11 @@ impl Names<'_, '_> {
                     .cloned()
                     .unwrap_or(format!("#{f}"))
             )
+        } else {
+            // Copy k ≥ 2 of n: the arm's name and the copy's number.
+            let (k, g) = (f / input.arm_faces, f % input.arm_faces);
+            let name = input.face_names.get(g).cloned().unwrap_or(format!("#{g}"));
+            format!("{name}′{k}")
         }
     }
 
@@ -278,7 +314,11 @@ impl Names<'_, '_> {
 
 /// Relations of the face pairs that count: arm–arm and arm–copy (copy–copy pairs are
 /// arm–arm pairs turned by 180°).
-fn face_pairs(input: &RobustnessInput<'_>, checker: &Checker) -> Vec<(usize, usize, Relation)> {
+fn face_pairs(
+    input: &RobustnessInput<'_>,
+    checker: &Checker,
+    copy_tips: &[(usize, usize)],
+) -> Vec<(usize, usize, Relation)> {
     let pat = input.pattern;
     let nf = pat.faces.len();
     let mut pairs: Vec<(usize, usize, Relation)> = Vec::new();
@@ -289,15 +329,19 @@ fn face_pairs(input: &RobustnessInput<'_>, checker: &Checker) -> Vec<(usize, usi
                 .copied()
                 .filter(|v| pat.faces[fb].contains(v))
                 .collect();
-            let tips = input.tip.is_some_and(|(g, c)| {
+            let meet = |(g, c): (usize, usize)| {
                 fb >= input.arm_faces && pat.faces[fa].contains(&g) && pat.faces[fb].contains(&c)
-            });
+            };
+            let tips = input
+                .tip
+                .filter(|&gc| meet(gc))
+                .or_else(|| copy_tips.iter().copied().find(|&gc| meet(gc)));
             let rel = match (shared.as_slice(), tips) {
-                ([], false) => Relation::Apart,
-                ([], true) => Relation::Tip,
-                ([v], false) => Relation::Wedge(*v),
+                ([], None) => Relation::Apart,
+                ([], Some((g, c))) => Relation::Tip(g, c),
+                ([v], None) => Relation::Wedge(*v),
                 // Touching at a shared vertex and at the tips: the intersection check's.
-                ([_], true) => continue,
+                ([_], Some(_)) => continue,
                 _ => match checker
                     .hinges()
                     .iter()
@@ -412,8 +456,7 @@ impl<'a> State<'a> {
                     format!("{} at {}", pair(), self.names.vertex(v))
                 });
             }
-            Relation::Tip => {
-                let (g, c) = self.input.tip.expect("tip pairs need the tips");
+            Relation::Tip(g, c) => {
                 // The tips are the apex (within the target's tolerance of it): the
                 // cones are those of the faces' other vertices.
                 let other = |f: usize| -> Vec<usize> {
@@ -473,6 +516,32 @@ impl<'a> State<'a> {
                 obstacle.offer(d, t, || {
                     format!("facet {} ↔ cylinder {}", self.names.face(f), k + 1)
                 });
+            }
+        }
+    }
+}
+
+impl State<'_> {
+    /// Offer the clearance of every face to every obstacle but the cylinders (which
+    /// [`State::obstacle_clearances`] judges) to `obstacle`. Faces whose bounding sphere
+    /// keeps off the obstacle's bounding ball by more than the least so far are skipped.
+    fn shape_clearances(&self, obstacles: &[Obstacle], obstacle: &mut Least) {
+        let t = self.frame.t;
+        for ob in obstacles {
+            if matches!(ob.shape, Shape::Cylinder(_)) {
+                continue;
+            }
+            let ball = ob.bounding_ball().map(|(c, r)| (V::from(c), r));
+            for (f, ts) in self.checker.triangles().iter().enumerate() {
+                if ball.is_some_and(|b| apart_beyond(self.spheres[f], b, obstacle.value)) {
+                    continue;
+                }
+                let tris: Vec<Tri> = ts.iter().map(|ix| self.tri(ix)).collect();
+                if let Some(d) = facet_clearance(&ob.shape, &tris) {
+                    obstacle.offer(d, t, || {
+                        format!("facet {} ↔ {}", self.names.face(f), ob.name)
+                    });
+                }
             }
         }
     }
@@ -569,131 +638,6 @@ fn cone_angle_below(apex: V, fa: &[usize], fb: &[usize], x: &[V], limit: f64) ->
         }
     }
     Some(cone_angle(apex, fa, fb, x))
-}
-
-/// Closest point of triangle `t` to `p` (Ericson, Real-Time Collision Detection, 5.1.5).
-fn closest_on_triangle(p: &V, t: &Tri) -> V {
-    let (a, b, c) = (t[0], t[1], t[2]);
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
-}
-
-/// Distance between segments `p1 q1` and `p2 q2` (Ericson 5.1.9).
-fn segment_distance(p1: &V, q1: &V, p2: &V, q2: &V) -> f64 {
-    let (d1, d2, r) = (q1 - p1, q2 - p2, p1 - p2);
-    let (a, e, f) = (d1.dot(&d1), d2.dot(&d2), d2.dot(&r));
-    let eps = 1e-300;
-    let (s, t) = if a <= eps && e <= eps {
-        (0.0, 0.0)
-    } else if a <= eps {
-        (0.0, (f / e).clamp(0.0, 1.0))
-    } else {
-        let c = d1.dot(&r);
-        if e <= eps {
-            ((-c / a).clamp(0.0, 1.0), 0.0)
-        } else {
-            let b = d1.dot(&d2);
-            let denom = a * e - b * b;
-            let mut s = if denom > 0.0 {
-                ((b * f - c * e) / denom).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let mut t = (b * s + f) / e;
-            if t < 0.0 {
-                t = 0.0;
-                s = (-c / a).clamp(0.0, 1.0);
-            } else if t > 1.0 {
-                t = 1.0;
-                s = ((b - c) / a).clamp(0.0, 1.0);
-            }
-            (s, t)
-        }
-    };
-    ((p1 + d1 * s) - (p2 + d2 * t)).norm()
-}
-
-/// Distance from `p` to segment `a b`.
-fn point_segment_distance(p: &V, a: &V, b: &V) -> f64 {
-    let ab = b - a;
-    let l = ab.norm_squared();
-    let s = if l > 0.0 {
-        ((p - a).dot(&ab) / l).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * s)).norm()
-}
-
-/// Exact distance between two triangles (0 when they cross).
-pub fn triangle_distance(a: &Tri, b: &Tri) -> f64 {
-    if triangles_intersect(a, b, 0.0) {
-        return 0.0;
-    }
-    let mut d = f64::INFINITY;
-    for p in a {
-        d = d.min((p - closest_on_triangle(p, b)).norm());
-    }
-    for p in b {
-        d = d.min((p - closest_on_triangle(p, a)).norm());
-    }
-    for i in 0..3 {
-        for j in 0..3 {
-            d = d.min(segment_distance(
-                &a[i],
-                &a[(i + 1) % 3],
-                &b[j],
-                &b[(j + 1) % 3],
-            ));
-        }
-    }
-    d
-}
-
-/// Exact distance between segment `p q` and a triangle (0 when it pierces it).
-pub fn segment_triangle_distance(p: &V, q: &V, t: &Tri) -> f64 {
-    let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
-    let (dp, dq) = (n.dot(&(p - t[0])), n.dot(&(q - t[0])));
-    if dp * dq <= 0.0 && dp != dq {
-        let x = p + (q - p) * (dp / (dp - dq));
-        if (x - closest_on_triangle(&x, t)).norm() <= 1e-15 * (1.0 + x.norm()) {
-            return 0.0;
-        }
-    }
-    let mut d = (p - closest_on_triangle(p, t))
-        .norm()
-        .min((q - closest_on_triangle(q, t)).norm());
-    for j in 0..3 {
-        d = d.min(segment_distance(p, q, &t[j], &t[(j + 1) % 3]));
-    }
-    d
 }
 
 /// Angle from unit vector `p` to the arc from `e1` to `e2` (shorter than π) on the sphere.
@@ -817,70 +761,6 @@ fn cone_angle(apex: V, fa: &[usize], fb: &[usize], x: &[V]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn t(p: [[f64; 3]; 3]) -> Tri {
-        p.map(V::from)
-    }
-
-    /// The distance between two triangles is the least distance between points of them:
-    /// dense sampling of both (barycentric grid) never goes below it and comes within the
-    /// grid's resolution of it.
-    #[test]
-    fn triangle_distance_matches_sampling() {
-        let cases = [
-            (
-                t([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
-                t([[0.2, 0.3, 0.5], [1.0, 1.0, 0.8], [-0.5, 1.0, 1.5]]),
-            ),
-            (
-                t([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
-                t([[1.5, 1.5, -1.0], [1.5, 1.5, 1.0], [3.0, 0.0, 0.0]]),
-            ),
-            (
-                t([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]),
-                t([[0.5, 0.5, 0.3], [0.6, 0.4, 2.0], [0.4, 0.7, 2.5]]),
-            ),
-        ];
-        let n = 60;
-        let pts = |tr: &Tri| -> Vec<V> {
-            let mut out = Vec::new();
-            for i in 0..=n {
-                for j in 0..=n - i {
-                    let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
-                    out.push(tr[0] + (tr[1] - tr[0]) * u + (tr[2] - tr[0]) * v);
-                }
-            }
-            out
-        };
-        for (a, b) in &cases {
-            let d = triangle_distance(a, b);
-            let (pa, pb) = (pts(a), pts(b));
-            let sampled = pa
-                .iter()
-                .flat_map(|p| pb.iter().map(move |q| (p - q).norm()))
-                .fold(f64::INFINITY, f64::min);
-            assert!(sampled >= d - 1e-12, "{sampled} < {d}");
-            assert!(sampled - d < 0.05, "{sampled} vs {d}");
-        }
-        // Crossing triangles are at distance 0.
-        let a = t([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]]);
-        let b = t([[0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [1.5, -1.0, 0.0]]);
-        assert_eq!(triangle_distance(&a, &b), 0.0);
-    }
-
-    #[test]
-    fn segment_triangle_distance_is_exact() {
-        let tri = t([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
-        // Parallel above the interior.
-        let d = segment_triangle_distance(&V::new(0.1, 0.1, 0.3), &V::new(0.3, 0.1, 0.3), &tri);
-        assert!((d - 0.3).abs() < 1e-15);
-        // Piercing.
-        let d = segment_triangle_distance(&V::new(0.2, 0.2, -1.0), &V::new(0.2, 0.2, 1.0), &tri);
-        assert_eq!(d, 0.0);
-        // Beyond an edge: closest to the edge x + y = 1 from (1, 1, 0) along z.
-        let d = segment_triangle_distance(&V::new(1.0, 1.0, -1.0), &V::new(1.0, 1.0, 1.0), &tri);
-        assert!((d - 0.5_f64.sqrt()).abs() < 1e-15, "{d}");
-    }
 
     #[test]
     fn cone_angle_of_two_wedges() {
