@@ -18,6 +18,10 @@ pub struct CompiledModel {
     pub n_vars: usize,
     /// Number of constraints.
     pub n_constraints: usize,
+    /// Number of auxiliary outputs after the constraints ([`super::Outputs::aux`]: 3 per
+    /// surface target), whose values and gradient rows [`ModelProblem::eval`] turns into
+    /// the surface terms.
+    pub n_aux: usize,
     /// Number of internal vertices (mode parameters come first).
     pub n_modes: usize,
     /// Milliseconds to build the expression graph (CPU time of the compiling thread, as
@@ -34,7 +38,8 @@ pub struct CompiledModel {
 }
 
 /// The symbolic outputs of `model`: free variable `k` is `Var(k)`, the others are the
-/// constants they are drawn at; parameters are the modes, then `model.times`.
+/// constants they are drawn at; parameters are the modes, then `model.times`. Outputs: the
+/// objective, the constraints, then the auxiliary outputs (surface targets' positions).
 pub fn symbolic(model: &Model) -> (Ctx, Vec<Sym>) {
     let ctx = Ctx::new();
     let free: Vec<Sym> = (0..model.free.len()).map(|k| ctx.var(k)).collect();
@@ -45,6 +50,7 @@ pub fn symbolic(model: &Model) -> (Ctx, Vec<Sym>) {
     let out = model.outputs(&vars, &modes, &times);
     let mut outputs = vec![out.objective];
     outputs.extend(out.constraints);
+    outputs.extend(out.aux);
     (ctx, outputs)
 }
 
@@ -77,7 +83,8 @@ impl CompiledModel {
         Ok(CompiledModel {
             modes_used,
             n_vars: model.free.len(),
-            n_constraints: ids.len() - 1,
+            n_constraints: ids.len() - 1 - model.surface_aux_len(),
+            n_aux: model.surface_aux_len(),
             n_modes: model.plan.internal.len(),
             compiled,
             build_ms,
@@ -116,6 +123,40 @@ impl CompiledModel {
             // The constraints' gradients are consecutive rows: the Jacobian in one copy.
             let rows = l.gradient(1).start..l.gradient(1).start + m * self.n_vars;
             e.dg.copy_from_slice(&buf[rows]);
+        }
+    }
+
+    /// Add the surface targets' terms to an unpacked evaluation: their values from the
+    /// auxiliary outputs in `buf`, their gradients by the chain rule through the aux
+    /// outputs' gradient rows; into the objective, or subtracted from the constraint
+    /// [`Model::surface_destination`] names.
+    pub fn add_surfaces(&self, model: &Model, buf: &[f64], e: &mut Evaluation) {
+        if self.n_aux == 0 {
+            return;
+        }
+        let l = &self.compiled.layout;
+        let base = 1 + self.n_constraints;
+        let aux = &buf[l.value(base)..l.value(base) + self.n_aux];
+        let dest = model.surface_destination();
+        for (j, (v, dx)) in model.surface_terms(aux).into_iter().enumerate() {
+            match dest {
+                None => e.f += v,
+                Some(k) => e.g[k] -= v,
+            }
+            if !l.gradients {
+                continue;
+            }
+            for (i, dxi) in dx.iter().enumerate() {
+                let row = &buf[l.gradient(base + 3 * j + i)];
+                let target = match dest {
+                    None => &mut e.df[..],
+                    Some(k) => &mut e.dg[k * self.n_vars..(k + 1) * self.n_vars],
+                };
+                let sign = if dest.is_none() { 1.0 } else { -1.0 };
+                for (t, r) in target.iter_mut().zip(row) {
+                    *t += sign * dxi * r;
+                }
+            }
         }
     }
 }
@@ -222,12 +263,22 @@ impl Problem for ModelProblem<'_> {
         let mut buf = self.buf.borrow_mut();
         self.compiled.call(x, &self.params, &mut buf);
         self.compiled.unpack(&buf, out);
+        self.compiled.add_surfaces(self.model, &buf, out);
     }
 }
 
-/// The objective value that means "target met" for the compiled objective (squared
-/// distance for one target, Eq. 38 otherwise).
+/// The value of the compiled objective at or below which a feasible point meets the
+/// target: what the search gives the optimizer as [`crate::optimize::Options::target`].
+/// Without an area term: `w² (threshold / w)²` for one target (the compiled objective is
+/// `w² d²`), `threshold` for several (`Σ w √(d² + ε²)`). With an area term: `+∞`, because
+/// the target is written as constraints (`threshold − Ω ≥ 0` when there are targets, and
+/// `A − at_least ≥ 0`), so every feasible point meets it, and the optimizer runs every
+/// start ([`crate::optimize::Options::all_starts`], see [`all_starts`]) keeping the least
+/// `−weight·A`.
 pub fn objective_target(model: &Model) -> f64 {
+    if model.area.is_some() {
+        return f64::INFINITY;
+    }
     if model.targets.len() == 1 {
         let w = model.targets[0].weight;
         (model.threshold / w).powi(2) * w * w
@@ -236,10 +287,35 @@ pub fn objective_target(model: &Model) -> f64 {
     }
 }
 
-/// f64 evaluation of the same outputs (the plain kinematics, no symbols).
+/// Whether the optimizer should run every start for `model` (it has an area term: no
+/// natural zero, so the first start meeting the target is no reason to stop).
+pub fn all_starts(model: &Model) -> bool {
+    model.area.is_some()
+}
+
+/// The record's `meets_target`: the optimized point is feasible (every constraint of the
+/// model holds within the optimizer's feasibility tolerance — with an area term these
+/// include `threshold − Ω_smooth ≥ 0` and `A − at_least ≥ 0`) and the reported Ω
+/// ([`Model::omega`], `Σ w d` over the targets, 0 without targets) is at most the
+/// threshold. With an area term the second condition follows from the first up to the
+/// smoothing (Ω ≤ Ω_smooth); it is what the search decided before issue 31, unchanged.
+pub fn meets_target(model: &Model, feasible: bool, omega: f64) -> bool {
+    feasible && omega <= model.threshold
+}
+
+/// f64 evaluation of the same outputs (the plain kinematics, no symbols): the objective
+/// and the constraints, surface terms included (as [`ModelProblem::eval`] adds them).
 pub fn outputs_f64(model: &Model, free: &[f64], modes: &[f64]) -> (f64, Vec<f64>) {
     let vars = model.full_vars(free);
     let times: Vec<f64> = model.times.clone();
     let out = model.outputs(&vars, modes, &times);
-    (out.objective, out.constraints)
+    let (mut f, mut g) = (out.objective, out.constraints);
+    let dest = model.surface_destination();
+    for (v, _) in model.surface_terms(&out.aux) {
+        match dest {
+            None => f += v,
+            Some(k) => g[k] -= v,
+        }
+    }
+    (f, g)
 }

@@ -19,6 +19,8 @@ pub fn interface(
     name: &str,
 ) -> Interface {
     let (n, m) = (compiled.n_vars, compiled.n_constraints);
+    // Outputs before the gradients: objective, constraints, surface targets' positions.
+    let n_out = 1 + m + compiled.n_aux;
     let up = name.to_ascii_uppercase();
     let vars = model
         .free
@@ -55,7 +57,24 @@ pub fn interface(
     }));
     let mut outputs = vec!["objective".to_string()];
     outputs.extend((0..m).map(|k| model.constraint_label(k)));
-    let objective = if model.targets.len() == 1 {
+    outputs.extend(
+        model
+            .targets
+            .iter()
+            .filter(|t| t.surface().is_some())
+            .enumerate()
+            .flat_map(|(j, t)| {
+                ["x", "y", "z"].map(|c| {
+                    format!(
+                        "aux {j}: {c} of v{} at t = {} (surface target; its distance is added outside)",
+                        model.plan.vertices[t.vertex].name, t.t
+                    )
+                })
+            }),
+    );
+    let objective = if model.area.is_some() {
+        "-weight * A, the area term to maximize (the targets' Omega <= threshold is a constraint)"
+    } else if model.targets.len() == 1 {
         "w^2 * |X_g(t) - P|^2, the squared distance of the gripping vertex from its target"
     } else {
         "sum over the targets of w * sqrt(|X_g(t) - P|^2 + 1e-18) (Eq. 38)"
@@ -110,12 +129,12 @@ pub fn interface(
         ),
         c(
             "gradient_offset",
-            1 + m,
+            n_out,
             "out[GRADIENT_OFFSET + i]: d objective / d vars[i]",
         ),
         c(
             "jacobian_offset",
-            1 + m + n,
+            n_out + n,
             "out[JACOBIAN_OFFSET + k*N_VARS + i]: d g_k / d vars[i]",
         ),
     ];
@@ -141,11 +160,15 @@ pub fn manifest(
 ) -> Json {
     let mut out = aot::manifest(iface, &compiled.compiled.layout);
     let (n, m) = (compiled.n_vars, compiled.n_constraints);
+    let n_out = 1 + m + compiled.n_aux;
     let layout = &mut out["layout"];
     layout["objective"] = json!({"offset": 0});
     layout["constraints"] = json!({"offset": 1, "len": m});
-    layout["gradient"] = json!({"offset": 1 + m, "len": n});
-    layout["jacobian"] = json!({"offset": 1 + m + n, "rows": m, "cols": n, "order": "row-major"});
+    if compiled.n_aux > 0 {
+        layout["aux"] = json!({"offset": 1 + m, "len": compiled.n_aux});
+    }
+    layout["gradient"] = json!({"offset": n_out, "len": n});
+    layout["jacobian"] = json!({"offset": n_out + n, "rows": m, "cols": n, "order": "row-major"});
     let rep = &compiled.compiled.report;
     let dropped: Vec<Json> = model
         .plan
@@ -169,7 +192,10 @@ pub fn manifest(
         "fixed_variables": dropped,
         "times": model.times,
         "t_max": model.t_max,
-        "targets": model.targets.iter().map(|t| json!({"t": t.t, "point": t.point, "weight": t.weight})).collect::<Vec<_>>(),
+        "targets": model.targets.iter().map(|t| match t.tip_point() {
+            Some(p) => json!({"t": t.t, "point": p, "weight": t.weight}),
+            None => json!({"t": t.t, "vertex": model.plan.vertices[t.vertex].name, "goal": t.goal, "weight": t.weight}),
+        }).collect::<Vec<_>>(),
         "threshold": model.threshold,
         "objective_target": objective_target(model),
         "n_constraints": compiled.n_constraints,

@@ -7,6 +7,7 @@
 //! constraints ψ, and the choice of gripping vertex. The same code runs in `f64` (the
 //! numeric path that verification and export read) and on symbols (the compiled model).
 
+pub mod area;
 pub mod clearance;
 pub mod compiled;
 pub mod cycle;
@@ -14,9 +15,13 @@ pub mod geometry;
 pub mod interface;
 pub mod linalg;
 pub mod numeric;
+pub mod orientation;
 pub mod plan;
 pub mod robust;
 pub mod select;
+pub mod surface;
+pub mod targets;
+pub mod terms;
 
 pub use plan::{Constraint, Plan, PlanError};
 
@@ -26,21 +31,7 @@ use crate::task::Task;
 use geometry::{Flat, Folded};
 
 pub use crate::task::Bounds;
-
-/// A point the gripping vertex should reach at parameter `t`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Target {
-    /// The driving parameter.
-    pub t: f64,
-    /// The point.
-    pub point: [f64; 3],
-    /// Its weight in the objective.
-    pub weight: f64,
-}
-
-/// Smoothing of `‖d‖` in multi-target objectives: `√(‖d‖² + ε²)`, so the gradient exists
-/// where a target is hit exactly. Far below any threshold a task can state.
-pub const DISTANCE_SMOOTHING: f64 = 1e-9;
+pub use targets::{Combination, DISTANCE_SMOOTHING, Target};
 
 /// Eq. 33 is imposed with this margin (radians): `U_j + U_k − U_i ≥ RIGID_MARGIN` at
 /// t_max. At a margin of exactly 0 the vertex triangle is degenerate and its angles move
@@ -74,8 +65,20 @@ pub struct Model {
     pub bounds: Bounds,
     /// End of the motion.
     pub t_max: f64,
-    /// Targets of the gripping vertex (Eq. 37: one; Eq. 38: a trajectory).
+    /// The targets of Ω (Eq. 37: one; Eq. 38: a trajectory), generalized to any vertex and
+    /// any goal (issue 31), in the task's order.
     pub targets: Vec<Target>,
+    /// How the targets' terms are combined (one target and no area term: squared).
+    pub combination: Combination,
+    /// The meshes of surface goals, prepared for nearest-point queries (index =
+    /// [`crate::task::terms::Goal::Surface`]'s `index`).
+    pub surfaces: Vec<surface::Surface>,
+    /// The orientation requirements, resolved on this graph (constraints at their states).
+    pub orientations: Vec<orientation::Orientation>,
+    /// The area term to maximize, if the task has one.
+    pub area: Option<crate::task::terms::AreaTerm>,
+    /// The task's copies (the flat area counts each; the packing footprint covers all).
+    pub copies: crate::scene::Copies,
     /// Success threshold on Ω.
     pub threshold: f64,
     /// Which of the three successors of the vertex extended last grips (0, 1, 2).
@@ -117,25 +120,9 @@ impl Model {
             .objective
             .as_ref()
             .ok_or_else(|| err("the task has no [objective] with targets"))?;
-        if objective.targets.is_empty() {
-            return Err(err("the objective has no targets"));
+        if objective.targets.is_empty() && objective.area.is_none() {
+            return Err(err("the objective has no targets and no area term"));
         }
-        // Point targets of the gripping vertex: the thesis's objective (Eq. 37–38).
-        let targets: Vec<Target> = objective
-            .targets
-            .iter()
-            .map(|t| match (&t.vertex, t.point()) {
-                (crate::task::terms::VertexRef::Tip, Some(point)) => Ok(Target {
-                    t: t.t,
-                    point,
-                    weight: t.weight,
-                }),
-                _ => Err(err(&format!(
-                    "objective.targets[{}]: only point targets of the tip are modelled",
-                    t.entry
-                ))),
-            })
-            .collect::<Result<_, _>>()?;
         let candidates = plan
             .candidates
             .ok_or_else(|| err("the graph has no extended vertex to grip with"))?;
@@ -143,6 +130,8 @@ impl Model {
             return Err(err("the gripping candidate must be 1, 2 or 3"));
         }
         let gripping = candidates[candidate];
+        let resolved = terms::resolve(&plan, task, objective, gripping)?;
+        let targets = resolved.targets;
         let mut times = vec![t_max];
         for t in &targets {
             if !times.contains(&t.t) {
@@ -156,11 +145,21 @@ impl Model {
                 }
             }
         }
+        let combination = if targets.len() == 1 && objective.area.is_none() {
+            Combination::Squared
+        } else {
+            Combination::Smoothed
+        };
         let mut model = Model {
             plan,
             bounds,
             t_max,
             targets,
+            combination,
+            surfaces: resolved.surfaces,
+            orientations: resolved.orientations,
+            area: objective.area,
+            copies: task.scene.copies.clone(),
             threshold: objective.threshold,
             candidate,
             gripping,
@@ -168,6 +167,12 @@ impl Model {
             times,
             kawasaki: task.kawasaki,
         };
+        // The new terms' states go last: the thesis's and the cyclic ones keep their places.
+        for t in terms::extra_times(&model) {
+            if !model.times.contains(&t) {
+                model.times.push(t);
+            }
+        }
         model.free = model.dependencies();
         Ok(model)
     }
@@ -187,6 +192,7 @@ impl Model {
         let out = self.outputs(&vars, &modes, &times);
         let mut ids = vec![ctx.node_id(&out.objective)];
         ids.extend(out.constraints.iter().map(|c| ctx.node_id(c)));
+        ids.extend(out.aux.iter().map(|c| ctx.node_id(c)));
         let graph = ctx.graph();
         let reach = graph.reachable(&ids);
         let mut used = vec![false; all.len()];
@@ -225,35 +231,20 @@ impl Model {
             .iter()
             .map(|t| geometry::fold(&self.plan, &flat, modes, t))
             .collect();
-        let mut terms = Vec::with_capacity(self.targets.len());
-        for target in &self.targets {
-            let k = self
-                .times
-                .iter()
-                .position(|s| *s == target.t)
-                .expect("every target time is in times");
-            let x = geometry::position(&self.plan, &flat, &folded[k], self.gripping);
-            let d2 = (0..3).fold(S::from_f64(0.0), |acc, i| {
-                let d = x[i].clone() - target.point[i];
-                acc + d.clone() * d
-            });
-            terms.push((target.weight, d2));
-        }
-        // One target: the squared distance (smooth at the optimum, same minimizer as
-        // Eq. 37). Several: Eq. 38's weighted sum of distances, smoothed at 1e-9.
-        let objective = if terms.len() == 1 {
-            terms[0].1.clone() * (terms[0].0 * terms[0].0)
-        } else {
-            terms.iter().fold(S::from_f64(0.0), |acc, (w, d2)| {
-                acc + (d2.clone() + DISTANCE_SMOOTHING * DISTANCE_SMOOTHING).sqrt() * *w
-            })
-        };
+        let omega = terms::omega(self, &flat, &folded);
         let mut constraints = self.constraints(&flat, &folded[0]);
         constraints.extend(cycle::constraints(self, &flat, &folded));
         constraints.extend(self.kawasaki_constraints(&flat));
+        constraints.extend(terms::constraints(self, &flat, &folded, &omega));
+        // With an area term Ω is a constraint and the objective is −weight·A.
+        let objective = match (self.area, terms::area_value(self, &flat, &folded)) {
+            (Some(term), Some(a)) => a * (-term.weight),
+            _ => omega,
+        };
         Outputs {
             objective,
             constraints,
+            aux: terms::aux(self, &flat, &folded),
         }
     }
 
@@ -338,26 +329,97 @@ impl Model {
         out
     }
 
-    /// Ω as the thesis states it (Eq. 37/38): `Σ w ‖P − X_g(t)‖`, from the f64 path.
+    /// Ω as the thesis states it (Eq. 37/38), generalized: `Σ w d` over every target, `d`
+    /// the distance of its vertex at its state from its goal (point, line, plane or the
+    /// nearest triangle of a surface), from the f64 path. Point targets keep the thesis's
+    /// arithmetic.
     pub fn omega(&self, full_vars: &[f64], modes: &[f64]) -> f64 {
         let flat = geometry::flat(&self.plan, full_vars);
         self.targets
             .iter()
             .map(|target| {
                 let folded = geometry::fold(&self.plan, &flat, modes, &target.t);
-                let x = geometry::position(&self.plan, &flat, &folded, self.gripping);
-                let d: f64 = (0..3)
-                    .map(|i| (x[i] - target.point[i]).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
+                let x = geometry::position(&self.plan, &flat, &folded, target.vertex);
+                let d: f64 = match &target.goal {
+                    crate::task::terms::Goal::Point { point } => (0..3)
+                        .map(|i| (x[i] - point[i]).powi(2))
+                        .sum::<f64>()
+                        .sqrt(),
+                    crate::task::terms::Goal::Surface { index } => self.surfaces[*index]
+                        .nearest(x)
+                        .map_or(f64::INFINITY, |n| n.d2.sqrt()),
+                    goal => targets::squared_distance(&x, goal)
+                        .expect("line and plane distances are expressions")
+                        .sqrt(),
+                };
                 target.weight * d
             })
             .sum()
     }
 
+    /// The area term `A` of a design (flat area × copies, or the packing ratio), from the
+    /// f64 path; `None` without an area term.
+    pub fn area(&self, full_vars: &[f64], modes: &[f64]) -> Option<f64> {
+        self.area?;
+        let flat = geometry::flat(&self.plan, full_vars);
+        let folded: Vec<Folded<f64>> = self
+            .times
+            .iter()
+            .map(|t| geometry::fold(&self.plan, &flat, modes, t))
+            .collect();
+        terms::area_value(self, &flat, &folded)
+    }
+
+    /// The surface targets' terms from the auxiliary outputs `aux` ([`Outputs::aux`]): per
+    /// surface target, in order, its term (`w² d²` or `w √(d² + ε²)` as
+    /// [`Model::combination`] says, `d` the distance to the nearest triangle) and the
+    /// term's gradient with respect to the vertex's position (Danskin: through the nearest
+    /// point `q`, `∂d²/∂x = 2 (x − q)`).
+    pub fn surface_terms(&self, aux: &[f64]) -> Vec<(f64, [f64; 3])> {
+        self.targets
+            .iter()
+            .filter_map(|t| t.surface().map(|s| (t, s)))
+            .enumerate()
+            .map(|(j, (t, s))| {
+                let x = [aux[3 * j], aux[3 * j + 1], aux[3 * j + 2]];
+                let near = self.surfaces[s]
+                    .nearest(x)
+                    .expect("surface goals have triangles (checked when the model is built)");
+                let (v, dv) = self.combination.term_f64(t.weight, near.d2);
+                (
+                    v,
+                    std::array::from_fn(|i| dv * 2.0 * (x[i] - near.point[i])),
+                )
+            })
+            .collect()
+    }
+
+    /// Where the surface terms go: `None` into the objective, `Some(k)` subtracted from
+    /// constraint `k` (`threshold − Ω ≥ 0`, when an area term makes Ω a constraint).
+    pub fn surface_destination(&self) -> Option<usize> {
+        terms::omega_constraint(self).map(|j| self.new_terms_offset() + j)
+    }
+
+    /// Number of auxiliary outputs ([`Outputs::aux`]): 3 per surface target.
+    pub fn surface_aux_len(&self) -> usize {
+        3 * self
+            .targets
+            .iter()
+            .filter(|t| t.surface().is_some())
+            .count()
+    }
+
+    /// Index of the first constraint of the task language's terms (orientation, area).
+    fn new_terms_offset(&self) -> usize {
+        self.plan.constraints.len() + cycle::count(self) + 2 * self.kawasaki_vertices().len()
+    }
+
     /// A readable label of constraint `i`.
     pub fn constraint_label(&self, i: usize) -> String {
         let p = &self.plan;
+        if let Some(j) = i.checked_sub(self.new_terms_offset()) {
+            return terms::label(self, j);
+        }
         if let Some(j) = i.checked_sub(p.constraints.len())
             && j < cycle::count(self)
         {
@@ -417,8 +479,13 @@ impl Model {
 /// Objective and constraints of a model.
 #[derive(Clone, Debug)]
 pub struct Outputs<S> {
-    /// The objective minimized (squared distance for one target; Eq. 38 otherwise).
+    /// The objective minimized (squared distance for one target; Eq. 38 otherwise; `−weight·A`
+    /// with an area term). Surface targets are not in it: see [`Outputs::aux`].
     pub objective: S,
     /// Constraints `g ≥ 0`.
     pub constraints: Vec<S>,
+    /// Auxiliary outputs the graph cannot finish: the position (x, y, z) of every surface
+    /// target's vertex at its state, in target order; [`Model::surface_terms`] adds their
+    /// distances numerically.
+    pub aux: Vec<S>,
 }

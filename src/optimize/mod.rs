@@ -160,6 +160,13 @@ pub struct Options {
     pub give_up_after: usize,
     /// See [`Options::give_up_after`]; values below 1 count as 1.
     pub give_up_factor: f64,
+    /// Run every start and keep the best objective among the points that meet the target,
+    /// instead of stopping at the first start that meets it: for objectives with no natural
+    /// zero (an area to maximize, whose target is written as constraints, so any feasible
+    /// point meets it). Each start then runs its augmented Lagrangian until it converges
+    /// (or its outer iterations end) rather than returning at its first point that meets
+    /// the target, and [`Options::give_up_after`] does not apply. Off by default.
+    pub all_starts: bool,
 }
 
 impl Default for Options {
@@ -179,6 +186,7 @@ impl Default for Options {
             robust_starts: 4,
             give_up_after: 10,
             give_up_factor: 4.0,
+            all_starts: false,
         }
     }
 }
@@ -446,7 +454,7 @@ impl<P: Problem> Lagrangian<'_, P> {
         // longer shrinks under a stiff penalty, or feasible at a local minimum short of the
         // target.
         let mut history: Vec<(f64, f64)> = Vec::new();
-        for _ in 0..max_outer {
+        for outer in 0..max_outer {
             let merit = Merit::new(
                 self.problem,
                 robust,
@@ -477,7 +485,12 @@ impl<P: Problem> Lagrangian<'_, P> {
             }
             let f = self.eval.f;
             if violation <= opts.feasibility_tol {
-                if opts.target.is_some_and(|t| f <= t) {
+                // With `all_starts` a start keeps improving its objective: it is judged
+                // (and the block asked) once it has converged or its iterations end.
+                let settled = !opts.all_starts
+                    || outer + 1 == max_outer
+                    || (f - prev_f).abs() <= opts.rel_tol * (1.0 + f.abs());
+                if settled && opts.target.is_some_and(|t| f <= t) {
                     let acc = robust.map(|r| r.accept(&x));
                     match acc {
                         None | Some(Acceptance::Accepted) => return true,
@@ -592,6 +605,9 @@ impl SharedStarts {
 /// Whether [`Options::give_up_after`] stops a problem after `starts_run` starts whose
 /// best feasible objective is `best_feasible_f` (infinite when none was feasible).
 fn gives_up(opts: &Options, starts_run: usize, best_feasible_f: f64) -> bool {
+    if opts.all_starts {
+        return false;
+    }
     match opts.target {
         Some(t) if t > 0.0 && opts.give_up_after > 0 && starts_run >= opts.give_up_after => {
             // Never NaN: only finite objectives count as feasible, and `max` drops a NaN factor.
@@ -691,12 +707,12 @@ pub fn minimize_shared<P: Problem>(
             None => met,
             Some(_) => met && robust_ok == Some(true),
         };
-        if done || gives_up(opts, start + 1, best_feasible_f) {
+        if (done && !opts.all_starts) || gives_up(opts, start + 1, best_feasible_f) {
             break;
         }
     }
     let mut best = best.expect("at least one start");
-    let done = best.met_target && best.robust != Some(false);
+    let done = best.met_target && best.robust != Some(false) && !opts.all_starts;
     best.starts_run = if done { best.start + 1 } else { starts_run };
     best.evaluations = evaluations + counter.get() + replayed_evaluations;
     best.robust_attempts = attempts;

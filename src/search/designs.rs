@@ -283,16 +283,17 @@ pub fn model_meta(task: &Task, model: &Model, modes: &[String], objective: f64) 
         // The vertex name (1-based), as in the rule sequence and the record.
         gripping_vertex: Some(model.plan.vertices[model.gripping].name),
         objective: Some(objective),
+        // The thesis's markers: point targets of the tip (other goals have no point).
         targets: model
             .targets
             .iter()
-            .map(|t| export::TargetPoint {
-                p: t.point,
-                t: Some(t.t),
+            .filter_map(|t| {
+                t.tip_point()
+                    .map(|p| export::TargetPoint { p, t: Some(t.t) })
             })
             .collect(),
         trajectory: if multi {
-            model.targets.iter().map(|t| t.point).collect()
+            model.targets.iter().filter_map(|t| t.tip_point()).collect()
         } else {
             Vec::new()
         },

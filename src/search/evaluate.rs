@@ -105,6 +105,7 @@ fn optimize_alternative(
         starts: opts.starts,
         seed: shared.seed(),
         target: Some(objective_target(model)),
+        all_starts: crate::model::compiled::all_starts(model),
         max_outer: if model.plan.sinks.is_empty() {
             optimize::Options::default().max_outer
         } else {
@@ -147,7 +148,7 @@ fn optimized_record(
     omega: f64,
     optimize_ms: f64,
 ) -> AlternativeRecord {
-    let meets = sol.feasible && omega <= model.threshold;
+    let meets = crate::model::compiled::meets_target(model, sol.feasible, omega);
     let variables: BTreeMap<String, f64> = model
         .free
         .iter()
