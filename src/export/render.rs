@@ -229,13 +229,13 @@ impl<'a> Scene<'a> {
         };
         for st in &states {
             pts.extend(st.iter().copied());
-            if meta.second_arm {
+            if meta.second_arm() {
                 pts.extend(st.iter().map(|&p| mirror_z(p)));
             }
         }
         pts.extend(meta.targets.iter().map(|t| t.p));
         pts.extend(meta.trajectory.iter().copied());
-        if let Some(c) = &meta.obstacle {
+        if let Some(c) = &meta.first_cylinder() {
             pts.extend(cylinder_polys(c, 24).into_iter().flatten());
         }
         for p in pts {
@@ -289,13 +289,13 @@ impl<'a> Scene<'a> {
         for f in &self.pattern.faces {
             let pts: Vec<V3> = f.iter().map(|&v| coords[v]).collect();
             add_poly(&pts, FRONT, BACK, Some(OUTLINE));
-            if self.meta.second_arm {
+            if self.meta.second_arm() {
                 // Rotating by 180° about z keeps orientation, so the normal rule holds.
                 let pts2: Vec<V3> = pts.iter().map(|&p| mirror_z(p)).collect();
                 add_poly(&pts2, FRONT2, BACK2, Some(OUTLINE));
             }
         }
-        if let Some(c) = &self.meta.obstacle {
+        if let Some(c) = &self.meta.first_cylinder() {
             for poly in cylinder_polys(c, 24) {
                 add_poly(&poly, OBSTACLE, OBSTACLE, None);
             }

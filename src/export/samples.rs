@@ -197,13 +197,16 @@ pub fn demo_gripper() -> (Pattern, DesignMeta) {
             t: Some(PI / 2.0),
         }],
         trajectory: Vec::new(),
-        obstacle: Some(Cylinder {
-            a: [0.0, -1.0, 0.5],
-            b: [0.0, 1.0, 0.5],
-            radius: 0.25,
-        }),
-        second_arm: true,
+        scene: super::meta_file::legacy_scene(
+            Some(Cylinder {
+                a: [0.0, -1.0, 0.5],
+                b: [0.0, 1.0, 0.5],
+                radius: 0.25,
+            }),
+            true,
+        ),
         extra: Default::default(),
+        ..DesignMeta::default()
     };
     (p, meta)
 }
@@ -236,9 +239,8 @@ pub fn demo_arm() -> (Pattern, DesignMeta) {
         objective: Some(0.0),
         targets,
         trajectory,
-        obstacle: None,
-        second_arm: false,
         extra: Default::default(),
+        ..DesignMeta::default()
     };
     (p, meta)
 }

@@ -336,8 +336,8 @@ fn design_json(out_dir: &Path, d: &ReportDesign) -> Result<Value> {
         "geometry": geometry_json(&d.pattern)?,
         "targets": m.targets.iter().map(|t| [r4(t.p[0]), r4(t.p[1]), r4(t.p[2])]).collect::<Vec<_>>(),
         "trajectory": m.trajectory.iter().map(|q| [r4(q[0]), r4(q[1]), r4(q[2])]).collect::<Vec<_>>(),
-        "obstacle": m.obstacle,
-        "second_arm": m.second_arm,
+        "obstacle": m.first_cylinder(),
+        "second_arm": m.second_arm(),
     }))
 }
 
