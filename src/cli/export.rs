@@ -113,7 +113,17 @@ fn default_out(design: &Path, f: Format) -> PathBuf {
 /// Run `foldsynth export`.
 pub fn run(a: ExportArgs) -> anyhow::Result<()> {
     let d = DesignFile::read(&a.design)?;
-    let loaded = export::with_meshes(&d.meta)?;
+    // Mesh obstacles are read only for what draws or meshes the scene: the FOLD file and
+    // the crease pattern name them without their triangles.
+    let draws = !matches!(
+        a.format,
+        Format::Fold | Format::Svg | Format::Obj | Format::Stl
+    );
+    let loaded = if draws {
+        export::with_meshes(&d.meta)?
+    } else {
+        std::borrow::Cow::Borrowed(&d.meta)
+    };
     let (p, meta) = (&d.pattern, &*loaded);
     let out = a
         .out

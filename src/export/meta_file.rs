@@ -79,7 +79,13 @@ impl TryFrom<MetaFile> for DesignMeta {
                 );
             }
             Some(s) => s,
-            None => legacy_scene(m.obstacle, m.second_arm),
+            None => {
+                // Checked under its old name, so a message points at the key in the file.
+                if let Some(c) = &m.obstacle {
+                    shape("meta.obstacle", &Shape::Cylinder(*c)).map_err(|e| e.to_string())?;
+                }
+                legacy_scene(m.obstacle, m.second_arm)
+            }
         };
         Ok(DesignMeta {
             task: m.task,

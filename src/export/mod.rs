@@ -36,6 +36,7 @@ pub mod render;
 pub mod report;
 pub mod samples;
 pub mod scene_mesh;
+pub mod scene_polys;
 pub mod svg;
 pub mod verify;
 

@@ -113,7 +113,7 @@ pub fn scene_mesh(p: &Pattern, frame: Option<usize>, meta: &DesignMeta) -> Resul
 }
 
 /// Centre of the bounding box of `pts` and the radius of the ball about it holding them.
-fn extent(pts: &[V3]) -> (V3, f64) {
+pub fn extent(pts: &[V3]) -> (V3, f64) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in pts {
