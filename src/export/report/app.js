@@ -298,7 +298,8 @@
       return g;
     }
 
-    const translucent = (color, opacity) => new T.MeshLambertMaterial({ color: color, transparent: true, opacity: opacity, depthWrite: false, side: T.DoubleSide });
+    // side 2 is three.js's DoubleSide (not among the bundle's exports).
+    const translucent = (color, opacity) => new T.MeshLambertMaterial({ color: color, transparent: true, opacity: opacity, depthWrite: false, side: 2 });
 
     function meshGeometry(m) {
       const g = new T.BufferGeometry();
@@ -308,13 +309,20 @@
       return g;
     }
 
-    // A square of half side h through point p, normal to the unit n.
+    // A square of half side h about point p, normal to the unit n (two triangles).
     function square(p, nrm, h, material) {
-      const q = new T.Mesh(new T.PlaneGeometry(2 * h, 2 * h), material);
-      q.quaternion.setFromUnitVectors(new T.Vector3(0, 0, 1), new T.Vector3().fromArray(nrm));
-      q.position.fromArray(p);
-      return q;
+      const n3 = new T.Vector3().fromArray(nrm);
+      const helper = Math.abs(n3.x) < 0.9 ? new T.Vector3(1, 0, 0) : new T.Vector3(0, 1, 0);
+      const u = helper.cross(n3).normalize();
+      const v = n3.clone().cross(u);
+      const c = new T.Vector3().fromArray(p);
+      const corner = (a, b) => c.clone().add(u.clone().multiplyScalar(a * h)).add(v.clone().multiplyScalar(b * h)).toArray();
+      const vertices = [corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1)].flat();
+      return new T.Mesh(meshGeometry({ vertices: vertices, triangles: [0, 1, 2, 0, 2, 3] }), material);
     }
+
+    // A box's 12 triangles from its 8 corners (corner k: + on axis i where bit i is set).
+    const BOX_TRIANGLES = [0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5];
 
     // The point of the plane (p, n) nearest to c.
     function foot(p, nrm, c) {
@@ -351,10 +359,7 @@
           obj = new T.Mesh(new T.SphereGeometry(o.radius, 32, 16), grey());
           obj.position.fromArray(o.center);
         } else if (o.shape === 'box') {
-          obj = new T.Mesh(new T.BoxGeometry(2 * o.half[0], 2 * o.half[1], 2 * o.half[2]), grey());
-          const ax = o.axes.map((a) => new T.Vector3().fromArray(a));
-          obj.quaternion.setFromRotationMatrix(new T.Matrix4().makeBasis(ax[0], ax[1], ax[2]));
-          obj.position.fromArray(o.center);
+          obj = new T.Mesh(meshGeometry({ vertices: o.corners.flat(), triangles: BOX_TRIANGLES }), grey());
         } else if (o.shape === 'halfspace') {
           obj = square(foot(o.point, o.normal, center), o.normal, 1.5 * radius, grey());
         } else if (o.shape === 'mesh' && o.mesh) {
@@ -432,20 +437,20 @@
       const world = (data.scenes && data.scenes[d.scene]) || { obstacles: [], copies: { n: 1 }, containment: [], surfaces: [] };
       // Copy k: the arm turned by 2πk/n about the copies' axis (sharing the arm's geometry,
       // so the t slider moves every copy).
+      // (The bundled three.js has no Matrix4: a copy is a quaternion and a position.)
       const copies = [];
       const cp = world.copies;
       for (let k = 1; k < (cp.n || 1); k += 1) {
         const axis = new T.Vector3().fromArray(cp.direction);
+        const angle = (2 * Math.PI * k) / cp.n;
         const at = new T.Vector3().fromArray(cp.point);
-        const m = new T.Matrix4().makeTranslation(at.x, at.y, at.z)
-          .multiply(new T.Matrix4().makeRotationAxis(axis, (2 * Math.PI * k) / cp.n))
-          .multiply(new T.Matrix4().makeTranslation(-at.x, -at.y, -at.z));
+        const shift = at.clone().sub(at.clone().applyAxisAngle(axis, angle));
         const copy = arm(0xf7d2ad, 0xbcd0ea, 0.45);
         copy.name = 'arm:' + (k + 1);
-        copy.matrixAutoUpdate = false;
-        copy.matrix.copy(m);
+        copy.quaternion.setFromAxisAngle(axis, angle);
+        copy.position.copy(shift);
         content.add(copy);
-        copies.push(m);
+        copies.push({ axis: axis, angle: angle, shift: shift });
       }
       // Everything the view should frame: every frame of every copy, targets, obstacles.
       const pts = [];
@@ -453,7 +458,7 @@
       for (const f of frames) {
         for (let i = 0; i < n; i += 1) {
           pts.push([f[3 * i], f[3 * i + 1], f[3 * i + 2]]);
-          for (const m of copies) pts.push(v3.set(f[3 * i], f[3 * i + 1], f[3 * i + 2]).applyMatrix4(m).toArray());
+          for (const c of copies) pts.push(v3.set(f[3 * i], f[3 * i + 1], f[3 * i + 2]).applyAxisAngle(c.axis, c.angle).add(c.shift).toArray());
         }
       }
       for (const p of d.targets.concat(d.trajectory)) pts.push(p);
