@@ -35,7 +35,10 @@ fn png_decodes_to_the_requested_size() {
 fn gif_has_the_picked_frames_and_they_move() {
     let p = samples::single_crease(3.0, 100);
     let meta = DesignMeta {
-        second_arm: true,
+        scene: foldsynth::scene::Scene {
+            copies: foldsynth::scene::Copies::about_z(2),
+            ..Default::default()
+        },
         ..DesignMeta::default()
     };
     let scene = Scene::new(&p, &meta, Camera::default()).unwrap();

@@ -815,3 +815,111 @@ fn report_works_in_headless_chromium_moved_alone() {
             .starts_with("t = 1.5708 (90.0°)")
     );
 }
+
+/// A report of two designs in a scene with every shape: the scene (and its mesh) is
+/// embedded once for both, every obstacle, box, copy and goal kind is there, and in the
+/// browser the 3D view holds an object for each.
+#[test]
+fn report_draws_every_shape_of_the_scene_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let (p, meta) = samples::every_shape(dir.path()).unwrap();
+    let design = |id: &str| ReportDesign {
+        id: id.into(),
+        level: 1,
+        candidate: None,
+        pattern: p.clone(),
+        meta: meta.clone(),
+        robustness: None,
+        facts: Vec::new(),
+        design_file: None,
+        files: None,
+        verify: None,
+    };
+    let input = ReportInput {
+        summary: ReportSummary {
+            title: "every shape".into(),
+            task: "every shape".into(),
+            counts: Vec::new(),
+            timings: Vec::new(),
+            notes: Vec::new(),
+        },
+        task: Vec::new(),
+        tree: Vec::new(),
+        distribution: None,
+        designs: vec![design("a"), design("b")],
+    };
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    let report = write_report(&out, &input).unwrap();
+    let html = std::fs::read_to_string(&report).unwrap();
+    let data = embedded(&html);
+    let scenes = data["scenes"].as_array().unwrap();
+    assert_eq!(scenes.len(), 1, "one scene for both designs");
+    for d in data["designs"].as_array().unwrap() {
+        assert_eq!(d["scene"], 0);
+        let kinds: Vec<&str> = d["goals"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|g| g["kind"].as_str().unwrap())
+            .collect();
+        assert_eq!(kinds, ["line", "plane", "surface"]);
+    }
+    let s = &scenes[0];
+    let shapes: Vec<&str> = s["obstacles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|o| o["shape"].as_str().unwrap())
+        .collect();
+    assert_eq!(shapes, ["cylinder", "sphere", "box", "halfspace", "mesh"]);
+    // The octahedron's 8 triangles, its 6 vertices moved by scale 0.3 and the translation.
+    let mesh = &s["obstacles"][4]["mesh"];
+    assert_eq!(mesh["triangles"].as_array().unwrap().len(), 24);
+    let v = mesh["vertices"].as_array().unwrap();
+    assert_eq!(v.len(), 18);
+    assert_eq!((f(&v[0]), f(&v[1]), f(&v[2])), (1.8 + 0.3, 1.2, 0.6));
+    assert_eq!(s["surfaces"][0]["triangles"].as_array().unwrap().len(), 24);
+    assert_eq!(s["copies"]["n"], 3);
+    assert_eq!(s["containment"][0]["corners"].as_array().unwrap().len(), 8);
+    // The mesh is embedded once (as the obstacle and the surface), not per design.
+    assert_eq!(html.matches("\"triangles\":[").count(), 2);
+
+    // A missing mesh file: no report, an error naming it.
+    std::fs::remove_file(dir.path().join("octahedron.obj")).unwrap();
+    let e = write_report(&out, &input).unwrap_err().to_string();
+    assert!(e.contains("octahedron.obj"), "{e}");
+
+    let broken = dir.path().join("broken.html");
+    std::fs::write(&broken, "<!DOCTYPE html><html><body></body></html>").unwrap();
+    let v = drive(&[&report], &broken);
+    if v.is_null() {
+        return;
+    }
+    let r = &v["reports"][0];
+    assert!(
+        r["errors"].as_array().unwrap().is_empty(),
+        "{}",
+        r["errors"]
+    );
+    let objects = ids(&r["initial"]["detail"]["objects"]);
+    for name in [
+        "arm:1",
+        "arm:2",
+        "arm:3",
+        "obstacle:cylinder:post",
+        "obstacle:sphere:ball",
+        "obstacle:box:crate",
+        "obstacle:halfspace:floor",
+        "obstacle:mesh:part",
+        "containment:workspace",
+        "goal:line:0",
+        "goal:plane:1",
+        "goal:surface:2",
+    ] {
+        assert!(
+            objects.iter().any(|o| o == name),
+            "{name} not in {objects:?}"
+        );
+    }
+}

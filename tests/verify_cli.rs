@@ -435,7 +435,7 @@ fn documented_design_file_exports_and_verifies() {
         env!("CARGO_MANIFEST_DIR")
     );
     let d: DesignFile = serde_json::from_str(&std::fs::read_to_string(&design).unwrap()).unwrap();
-    assert!(d.meta.second_arm && d.meta.obstacle.is_some());
+    assert!(d.meta.second_arm() && d.meta.first_cylinder().is_some());
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("x.fold");
     let o = run(&[

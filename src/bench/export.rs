@@ -120,7 +120,7 @@ impl Subject<'_> {
             }),
         ));
         let last = p.frames.len().checked_sub(1);
-        let state = mesh::state_mesh(p, last, meta.second_arm)?;
+        let state = mesh::state_mesh_copies(p, last, &meta.scene.copies)?;
         rows.push((
             "OBJ and STL of the last state",
             time_ns(budget, || {

@@ -1,4 +1,4 @@
-//! `foldsynth export DESIGN.json --format fold|svg|obj|stl|gif|png|state-svg|all`.
+//! `foldsynth export DESIGN.json --format fold|svg|obj|stl|scene-obj|scene-stl|gif|png|state-svg|all`.
 //!
 //! The design file is `{"pattern": <Pattern>, "meta": <DesignMeta>}` (see
 //! [`crate::export::DesignFile`]); the synthesis stage writes one per feasible design.
@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 
-use crate::export::{self, DesignFile, ExportOptions, FoldSpec, mesh, render, svg};
+use crate::export::{self, DesignFile, ExportOptions, FoldSpec, mesh, render, scene_mesh, svg};
 
 /// What to write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -20,6 +20,10 @@ pub enum Format {
     Obj,
     /// STL mesh of one state (binary unless --stl-ascii).
     Stl,
+    /// OBJ of one state with every copy and every obstacle (one object each).
+    SceneObj,
+    /// STL of the same scene (binary unless --stl-ascii).
+    SceneStl,
     /// Animated GIF of the motion.
     Gif,
     /// PNG picture of one state.
@@ -37,6 +41,8 @@ impl Format {
             Format::Svg => "svg",
             Format::Obj => "obj",
             Format::Stl => "stl",
+            Format::SceneObj => "scene.obj",
+            Format::SceneStl => "scene.stl",
             Format::Gif => "gif",
             Format::Png => "png",
             Format::StateSvg => "state.svg",
@@ -69,7 +75,7 @@ pub struct ExportArgs {
     /// format's extension.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// State for png, obj, stl and state-svg: index into the pattern's frames
+    /// State for png, obj, stl, scene-obj, scene-stl and state-svg: index into the pattern's frames
     /// (0-based; default: the last frame).
     #[arg(long)]
     pub frame: Option<usize>,
@@ -107,7 +113,18 @@ fn default_out(design: &Path, f: Format) -> PathBuf {
 /// Run `foldsynth export`.
 pub fn run(a: ExportArgs) -> anyhow::Result<()> {
     let d = DesignFile::read(&a.design)?;
-    let (p, meta) = (&d.pattern, &d.meta);
+    // Mesh obstacles are read only for what draws or meshes the scene: the FOLD file and
+    // the crease pattern name them without their triangles.
+    let draws = !matches!(
+        a.format,
+        Format::Fold | Format::Svg | Format::Obj | Format::Stl
+    );
+    let loaded = if draws {
+        export::with_meshes(&d.meta)?
+    } else {
+        std::borrow::Cow::Borrowed(&d.meta)
+    };
+    let (p, meta) = (&d.pattern, &*loaded);
     let out = a
         .out
         .clone()
@@ -153,10 +170,21 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
             .into_bytes(),
         )?,
         Format::Obj => write(
-            mesh::to_obj(&mesh::state_mesh(p, frame, meta.second_arm)?, &meta.task).into_bytes(),
+            mesh::to_obj(
+                &mesh::state_mesh_copies(p, frame, &meta.scene.copies)?,
+                &meta.task,
+            )
+            .into_bytes(),
         )?,
-        Format::Stl => {
-            let m = mesh::state_mesh(p, frame, meta.second_arm)?;
+        Format::SceneObj => write(
+            scene_mesh::to_obj(&scene_mesh::scene_mesh(p, frame, meta)?, &meta.task).into_bytes(),
+        )?,
+        Format::Stl | Format::SceneStl => {
+            let m = if a.format == Format::Stl {
+                mesh::state_mesh_copies(p, frame, &meta.scene.copies)?
+            } else {
+                scene_mesh::scene_mesh(p, frame, meta)?.as_state_mesh()
+            };
             write(if a.stl_ascii {
                 mesh::to_stl_ascii(&m, &meta.task).into_bytes()
             } else {

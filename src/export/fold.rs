@@ -239,10 +239,19 @@ fn put_foldsynth_fields(top: &mut Vec<(String, String)>, p: &Pattern, meta: &Des
     if !meta.trajectory.is_empty() {
         top.push(put("foldsynth:trajectory", json!(meta.trajectory), 2));
     }
-    if let Some(c) = &meta.obstacle {
+    // The first cylinder and the half-turn copy as files before the scene wrote them (for
+    // readers that know only those), then the whole scene.
+    if let Some(c) = meta.first_cylinder() {
         top.push(put("foldsynth:obstacle", json!(c), 2));
     }
-    top.push(put("foldsynth:secondArm", json!(meta.second_arm), 2));
+    top.push(put("foldsynth:secondArm", json!(meta.second_arm()), 2));
+    top.push(put("foldsynth:scene", json!(meta.scene), 2));
+    if !meta.goals.is_empty() {
+        top.push(put("foldsynth:goals", json!(meta.goals), 2));
+    }
+    if !meta.surfaces.is_empty() {
+        top.push(put("foldsynth:surfaces", json!(meta.surfaces), 2));
+    }
     if !meta.extra.is_empty() {
         top.push(put("foldsynth:extra", json!(meta.extra), 2));
     }

@@ -10,6 +10,7 @@ use std::fmt::Write as _;
 use super::{ExportError, Result, validate_pattern};
 use crate::geom::{self, V3};
 use crate::pattern::Pattern;
+use crate::scene::Copies;
 
 /// A triangle mesh of one state; `arm` tells which copy each triangle belongs to.
 #[derive(Clone, Debug, PartialEq)]
@@ -18,7 +19,7 @@ pub struct StateMesh {
     pub positions: Vec<V3>,
     /// Triangles as indices into `positions`, counter-clockwise seen from the front.
     pub triangles: Vec<[usize; 3]>,
-    /// Number of arms (1, or 2 with the copy rotated 180° about z).
+    /// Number of arms (1, or the scene's copies: 2 with the copy rotated 180° about z).
     pub arms: usize,
     /// Triangles per arm (the first `per_arm` belong to arm 1, and so on).
     pub per_arm: usize,
@@ -71,6 +72,25 @@ pub fn state_mesh(p: &Pattern, frame: Option<usize>, both_arms: bool) -> Result<
         arms,
         per_arm: tris.len(),
     })
+}
+
+/// The mesh of frame `frame` with every rotational copy of `copies` appended (arm k + 1 is
+/// copy k). The thesis's half turn about z is [`state_mesh`] with both arms, bit for bit.
+pub fn state_mesh_copies(p: &Pattern, frame: Option<usize>, copies: &Copies) -> Result<StateMesh> {
+    if *copies == Copies::about_z(2) {
+        return state_mesh(p, frame, true);
+    }
+    let mut m = state_mesh(p, frame, false)?;
+    let arm = m.positions.clone();
+    let tris = m.triangles.clone();
+    for k in 1..copies.n.max(1) {
+        let base = m.positions.len();
+        m.positions.extend(arm.iter().map(|&p| copies.apply(k, p)));
+        m.triangles
+            .extend(tris.iter().map(|t| [t[0] + base, t[1] + base, t[2] + base]));
+    }
+    m.arms = copies.n.max(1);
+    Ok(m)
 }
 
 fn tri_normal(m: &StateMesh, t: &[usize; 3]) -> V3 {

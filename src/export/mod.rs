@@ -28,12 +28,15 @@
 pub mod fold;
 pub mod lzw;
 pub mod mesh;
+pub mod meta_file;
 pub mod palette;
 pub mod plots;
 pub mod raster;
 pub mod render;
 pub mod report;
 pub mod samples;
+pub mod scene_mesh;
+pub mod scene_polys;
 pub mod svg;
 pub mod verify;
 
@@ -76,45 +79,64 @@ pub struct TargetPoint {
 }
 
 /// A cylindrical obstacle (axis segment `a → b`, radius), shared with the checks.
-pub use crate::check::Cylinder;
+pub use crate::scene::Cylinder;
+use crate::scene::Scene;
+use crate::scene::shapes::MeshObstacle;
+use crate::task::terms::Target;
 
 /// Where a design came from and what it should do; filled by the synthesis stage.
 ///
-/// Serialized with snake_case keys; every field but `task` may be omitted.
+/// Serialized with snake_case keys; every field but `task` may be omitted. Files written
+/// before the scene existed name one cylinder (`obstacle`) and a half-turn copy
+/// (`second_arm`); they are still read, as a scene with that cylinder (named
+/// `check.cylinders[0]`) and two copies about z (see [`meta_file`]).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "meta_file::MetaFile")]
 pub struct DesignMeta {
     /// Name of the design task (e.g. `"gripper"`).
     pub task: String,
     /// Rule application sequence in the thesis's notation, e.g. `"2, 3, (4, 8)"`.
-    #[serde(default)]
     pub rule_sequence: String,
     /// RBM of every internal vertex, in the order of the internal vertices.
-    #[serde(default)]
     pub modes: Vec<Mode>,
     /// The gripping vertex by its name: 1-based, as vertices are numbered everywhere
     /// foldsynth talks to people (task files, rule sequences, the report, the design JSON's
     /// top-level `gripping_vertex`), so vertex `vK` is [`Pattern::vertices`]`[K − 1]`.
-    #[serde(default)]
     pub gripping_vertex: Option<usize>,
     /// The objective value Ω* of the optimized design.
-    #[serde(default)]
     pub objective: Option<f64>,
-    /// Target points (gripper: P_G; robotic arm: P_Ti with their t_i).
-    #[serde(default)]
+    /// Target points (gripper: P_G; robotic arm: P_Ti with their t_i), drawn as dots.
     pub targets: Vec<TargetPoint>,
     /// A trajectory to draw as a polyline (e.g. the robotic arm's arc).
-    #[serde(default)]
     pub trajectory: Vec<[f64; 3]>,
-    /// An obstacle to draw (gripper task).
-    #[serde(default)]
-    pub obstacle: Option<Cylinder>,
-    /// Draw (and mesh) a second arm: the pattern rotated 180° about z (two-armed gripper).
-    #[serde(default)]
-    pub second_arm: bool,
+    /// The world around the design: obstacles of every shape, the rotational copies of
+    /// the arm, containment boxes. Mesh obstacles name their file (loaded to draw).
+    pub scene: Scene,
+    /// The objective's targets of every kind (point, line, plane, surface) with their
+    /// vertex, t and weight, as the task gives them (paths expanded). Point goals are
+    /// drawn from [`DesignMeta::targets`]; the others from here.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub goals: Vec<Target>,
+    /// The meshes [`crate::task::terms::Goal::Surface`] goals refer to (by index), named by
+    /// their files like mesh obstacles.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub surfaces: Vec<MeshObstacle>,
     /// Anything else worth keeping (written to FOLD under `foldsynth:extra`).
-    #[serde(default)]
     pub extra: BTreeMap<String, serde_json::Value>,
+}
+
+impl DesignMeta {
+    /// The first cylinder of the scene (what files before the scene called `obstacle`).
+    pub fn first_cylinder(&self) -> Option<&Cylinder> {
+        self.scene.cylinders().next()
+    }
+
+    /// Whether the copies are exactly the thesis's second arm: a half turn about the
+    /// z-axis, drawn and meshed as `(−x, −y, z)` (the code paths of files before the
+    /// scene, kept so their bytes do not change).
+    pub fn second_arm(&self) -> bool {
+        self.scene.copies == crate::scene::Copies::about_z(2)
+    }
 }
 
 /// Errors of the export stage.
@@ -166,7 +188,7 @@ pub(crate) fn write_file(path: &Path, bytes: impl AsRef<[u8]>) -> Result<()> {
 
 /// Every number finite and within ±[`crate::limits::COORD_MAX`]: larger ones overflow
 /// squared distances (1e308 gives an infinite error that compares as "within bounds").
-fn check_finite(what: impl FnOnce() -> String, xs: &[f64]) -> Result<()> {
+pub(crate) fn check_finite(what: impl FnOnce() -> String, xs: &[f64]) -> Result<()> {
     match xs
         .iter()
         .find(|x| !(x.is_finite() && x.abs() <= crate::limits::COORD_MAX))
@@ -285,26 +307,7 @@ pub fn validate_meta(meta: &DesignMeta, p: &Pattern) -> Result<()> {
     for (i, q) in meta.trajectory.iter().enumerate() {
         check_finite(|| format!("meta.trajectory[{i}]"), q)?;
     }
-    if let Some(c) = &meta.obstacle {
-        check_finite(|| "meta.obstacle.a".into(), &c.a)?;
-        check_finite(|| "meta.obstacle.b".into(), &c.b)?;
-        if !(c.radius.is_finite() && c.radius > 0.0 && c.radius <= crate::limits::COORD_MAX) {
-            return Err(ExportError::invalid(
-                "meta.obstacle.radius",
-                format!(
-                    "{} is not allowed; the radius must be > 0 and at most {}",
-                    crate::text::num(c.radius),
-                    crate::text::num(crate::limits::COORD_MAX)
-                ),
-            ));
-        }
-        if crate::geom::norm(crate::geom::sub(c.b, c.a)) == 0.0 {
-            return Err(ExportError::invalid(
-                "meta.obstacle",
-                "the axis ends a and b coincide",
-            ));
-        }
-    }
+    meta_file::validate_scene(meta)?;
     Ok(())
 }
 
@@ -386,6 +389,10 @@ pub struct Files {
     pub obj: PathBuf,
     /// STL of the final folded state.
     pub stl: PathBuf,
+    /// OBJ of the scene at the final state: every copy and every obstacle (`<name>-scene.obj`).
+    pub scene_obj: PathBuf,
+    /// STL of the same scene (`<name>-scene.stl`).
+    pub scene_stl: PathBuf,
     /// PNG pictures of selected folded states, in order of t.
     pub pngs: Vec<PathBuf>,
     /// SVG pictures of the same folded states.
@@ -420,6 +427,8 @@ impl Files {
             self.svg.clone(),
             self.obj.clone(),
             self.stl.clone(),
+            self.scene_obj.clone(),
+            self.scene_stl.clone(),
         ];
         for (png, svg) in self.pngs.iter().zip(&self.folded_svgs) {
             v.push(png.clone());
@@ -440,6 +449,8 @@ pub fn planned_files(out_dir: &Path, pattern: &Pattern, opts: &ExportOptions) ->
         svg: path("svg"),
         obj: path("obj"),
         stl: path("stl"),
+        scene_obj: out_dir.join(format!("{}-scene.obj", opts.name)),
+        scene_stl: out_dir.join(format!("{}-scene.stl", opts.name)),
         pngs: picked
             .iter()
             .map(|k| out_dir.join(format!("{}_state{k}.png", opts.name)))
@@ -454,7 +465,9 @@ pub fn planned_files(out_dir: &Path, pattern: &Pattern, opts: &ExportOptions) ->
 
 /// Write every file for one design into `out_dir` (created if missing): FOLD, crease
 /// pattern SVG, OBJ and STL of the final state, PNG and SVG pictures of a few states,
-/// and the GIF animation. With `meta.second_arm`, pictures and meshes show both arms.
+/// the scene (every copy, every obstacle) as OBJ and STL, and the GIF animation. Pictures
+/// and meshes show every copy of `meta.scene`. Mesh obstacles are read from their files
+/// (an error names a missing one).
 pub fn write_all(
     out_dir: &Path,
     pattern: &Pattern,
@@ -474,6 +487,8 @@ pub fn write_all(
         source,
     })?;
     let files = planned_files(out_dir, pattern, opts);
+    let loaded = with_meshes(meta)?;
+    let meta = &*loaded;
     write_file(
         &files.fold,
         fold::to_fold_string(pattern, meta, opts.fold_spec)?,
@@ -490,14 +505,19 @@ pub fn write_all(
         )?,
     )?;
     let last = pattern.frames.len().checked_sub(1);
-    let state = mesh::state_mesh(pattern, last, meta.second_arm)?;
+    let state = mesh::state_mesh_copies(pattern, last, &meta.scene.copies)?;
     write_file(&files.obj, mesh::to_obj(&state, &opts.name))?;
-    let stl = if opts.stl_binary {
-        mesh::to_stl_binary(&state)
-    } else {
-        mesh::to_stl_ascii(&state, &opts.name).into_bytes()
+    let stl = |m: &mesh::StateMesh| {
+        if opts.stl_binary {
+            mesh::to_stl_binary(m)
+        } else {
+            mesh::to_stl_ascii(m, &opts.name).into_bytes()
+        }
     };
-    write_file(&files.stl, stl)?;
+    write_file(&files.stl, stl(&state))?;
+    let world = scene_mesh::scene_mesh(pattern, last, meta)?;
+    write_file(&files.scene_obj, scene_mesh::to_obj(&world, &opts.name))?;
+    write_file(&files.scene_stl, stl(&world.as_state_mesh()))?;
 
     let scene = render::Scene::new(pattern, meta, opts.camera)?;
     let picked = picked_frames(pattern.frames.len(), opts.picture_states);
@@ -528,6 +548,24 @@ pub fn write_all(
         write_file(fsvg, scene.svg(Some(*k), opts.image_size))?;
     }
     Ok(files)
+}
+
+/// `meta` with every mesh it names read from its file: borrowed when there is none to read
+/// (or all are read already), else a copy with the meshes loaded.
+pub fn with_meshes(meta: &DesignMeta) -> Result<std::borrow::Cow<'_, DesignMeta>> {
+    use crate::scene::Shape;
+    let unloaded = meta
+        .scene
+        .obstacles
+        .iter()
+        .any(|o| matches!(&o.shape, Shape::Mesh(m) if m.triangles().is_none()))
+        || meta.surfaces.iter().any(|m| m.triangles().is_none());
+    if !unloaded {
+        return Ok(std::borrow::Cow::Borrowed(meta));
+    }
+    let mut m = meta.clone();
+    meta_file::load_meshes(&mut m)?;
+    Ok(std::borrow::Cow::Owned(m))
 }
 
 /// The JSON file `foldsynth export` reads: `{"pattern": <Pattern>, "meta": <DesignMeta>}`.

@@ -7,8 +7,11 @@
 //! translucent mesh sorted with the facets. Target points (red), the trajectory (green
 //! polyline) and the gripping vertex with its path over the frames (black) are drawn on
 //! top so they stay visible. With [`DesignMeta::second_arm`] the pattern rotated 180°
-//! about z is drawn as well, in its own colours. The scale is fixed over all frames so an
-//! animation does not jump.
+//! about z is drawn as well, in its own colours (exactly as before the scene existed); other
+//! copies of [`DesignMeta::scene`] are turned about their axis. The scene's other obstacles
+//! (spheres, boxes, half-spaces as a square of their plane, further cylinders, loaded
+//! meshes) are translucent polygons like the cylinder, its containment boxes dashed
+//! wireframes. The scale is fixed over all frames so an animation does not jump.
 
 use rayon::prelude::*;
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
@@ -19,7 +22,7 @@ use super::palette::{
 };
 pub use super::palette::{GifPalette, gif_palette};
 use super::raster::{self, Canvas, Indexed, Pen};
-use super::{DesignMeta, ExportError, Result, validate_meta, validate_pattern};
+use super::{DesignMeta, ExportError, Result, scene_polys, validate_meta, validate_pattern};
 use crate::geom::{self, V3};
 use crate::pattern::Pattern;
 
@@ -161,6 +164,9 @@ pub struct Scene<'a> {
     basis: (V3, V3, V3),
     lo: [f64; 2],
     hi: [f64; 2],
+    /// Centre and radius of a ball holding the arm in every state (where a half-space's
+    /// square is drawn, and how large).
+    extent: (V3, f64),
 }
 
 fn mirror_z(p: V3) -> V3 {
@@ -220,6 +226,7 @@ impl<'a> Scene<'a> {
             basis: camera.basis(),
             lo: [f64::INFINITY; 2],
             hi: [f64::NEG_INFINITY; 2],
+            extent: ([0.0; 3], 0.0),
         };
         let mut pts: Vec<V3> = Vec::new();
         let states: Vec<Vec<V3>> = if pattern.frames.is_empty() {
@@ -229,15 +236,31 @@ impl<'a> Scene<'a> {
         };
         for st in &states {
             pts.extend(st.iter().copied());
-            if meta.second_arm {
+            if meta.second_arm() {
                 pts.extend(st.iter().map(|&p| mirror_z(p)));
+            }
+        }
+        s.extent = super::scene_mesh::extent(&pts);
+        let copies = &meta.scene.copies;
+        if !meta.second_arm() {
+            for st in &states {
+                for k in 1..copies.n {
+                    pts.extend(st.iter().map(|&p| copies.apply(k, p)));
+                }
             }
         }
         pts.extend(meta.targets.iter().map(|t| t.p));
         pts.extend(meta.trajectory.iter().copied());
-        if let Some(c) = &meta.obstacle {
+        if let Some(c) = &meta.first_cylinder() {
             pts.extend(cylinder_polys(c, 24).into_iter().flatten());
         }
+        let (near, half) = (s.extent.0, s.extent.1.max(0.5));
+        pts.extend(
+            scene_polys::obstacle_polys(meta, near, half)
+                .into_iter()
+                .flatten(),
+        );
+        pts.extend(scene_polys::containment_edges(meta).into_iter().flatten());
         for p in pts {
             let q = s.project(p);
             for ((lo, hi), x) in s.lo.iter_mut().zip(s.hi.iter_mut()).zip(q) {
@@ -289,19 +312,38 @@ impl<'a> Scene<'a> {
         for f in &self.pattern.faces {
             let pts: Vec<V3> = f.iter().map(|&v| coords[v]).collect();
             add_poly(&pts, FRONT, BACK, Some(OUTLINE));
-            if self.meta.second_arm {
+            if self.meta.second_arm() {
                 // Rotating by 180° about z keeps orientation, so the normal rule holds.
                 let pts2: Vec<V3> = pts.iter().map(|&p| mirror_z(p)).collect();
                 add_poly(&pts2, FRONT2, BACK2, Some(OUTLINE));
+            } else {
+                // Any other copies: turned about their axis (rotations keep orientation).
+                let copies = &self.meta.scene.copies;
+                for k in 1..copies.n {
+                    let pk: Vec<V3> = pts.iter().map(|&p| copies.apply(k, p)).collect();
+                    add_poly(&pk, FRONT2, BACK2, Some(OUTLINE));
+                }
             }
         }
-        if let Some(c) = &self.meta.obstacle {
+        if let Some(c) = &self.meta.first_cylinder() {
             for poly in cylinder_polys(c, 24) {
                 add_poly(&poly, OBSTACLE, OBSTACLE, None);
             }
         }
+        let (near, half) = (self.extent.0, self.extent.1.max(0.5));
+        for poly in scene_polys::obstacle_polys(self.meta, near, half) {
+            add_poly(&poly, OBSTACLE, OBSTACLE, None);
+        }
         polys.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut items: Vec<Item> = polys.into_iter().map(|(_, it)| it).collect();
+        for e in scene_polys::containment_edges(self.meta) {
+            items.push(Item::Polyline {
+                pts: vec![self.project(e[0]), self.project(e[1])],
+                color: OUTLINE,
+                width: 1.0,
+                dashed: true,
+            });
+        }
 
         if self.meta.trajectory.len() >= 2 {
             items.push(Item::Polyline {

@@ -197,13 +197,16 @@ pub fn demo_gripper() -> (Pattern, DesignMeta) {
             t: Some(PI / 2.0),
         }],
         trajectory: Vec::new(),
-        obstacle: Some(Cylinder {
-            a: [0.0, -1.0, 0.5],
-            b: [0.0, 1.0, 0.5],
-            radius: 0.25,
-        }),
-        second_arm: true,
+        scene: super::meta_file::legacy_scene(
+            Some(Cylinder {
+                a: [0.0, -1.0, 0.5],
+                b: [0.0, 1.0, 0.5],
+                radius: 0.25,
+            }),
+            true,
+        ),
         extra: Default::default(),
+        ..DesignMeta::default()
     };
     (p, meta)
 }
@@ -236,9 +239,115 @@ pub fn demo_arm() -> (Pattern, DesignMeta) {
         objective: Some(0.0),
         targets,
         trajectory,
-        obstacle: None,
-        second_arm: false,
         extra: Default::default(),
+        ..DesignMeta::default()
     };
     (p, meta)
+}
+
+/// An OBJ octahedron with vertices at ±1 on each axis: 8 triangles, closed, facing
+/// outward (the mesh obstacle and the surface goal of [`every_shape`]).
+pub const OCTAHEDRON_OBJ: &str = "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
+f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n";
+
+/// [`demo_arm`]'s pattern in a scene with every kind of thing a task may put around it: a
+/// cylinder, a sphere, a turned box, a half-space (the floor), a mesh (an octahedron,
+/// written to `dir/octahedron.obj`, which the metadata names), a containment box, three
+/// copies about a tilted axis, and line, plane and surface goals beside a point goal.
+pub fn every_shape(dir: &std::path::Path) -> std::io::Result<(Pattern, DesignMeta)> {
+    use crate::scene::shapes::{HalfSpace, MeshObstacle, OrientedBox, Sphere, frame};
+    use crate::scene::{Containment, Copies, Obstacle, Scene, Shape};
+    use crate::task::terms::{Goal, Target, VertexRef};
+
+    let file = dir.join("octahedron.obj");
+    std::fs::write(&file, OCTAHEDRON_OBJ)?;
+    let octahedron = MeshObstacle {
+        file,
+        scale: 0.3,
+        translate: [1.8, 1.2, 0.6],
+        mesh: None,
+    };
+    let (p, mut meta) = demo_arm();
+    let obstacle = |name: &str, shape: Shape| Obstacle {
+        name: name.into(),
+        shape,
+    };
+    meta.task = "every shape".into();
+    meta.scene = Scene {
+        obstacles: vec![
+            obstacle(
+                "post",
+                Shape::Cylinder(Cylinder {
+                    a: [0.0, -1.0, 0.5],
+                    b: [0.0, 1.0, 0.5],
+                    radius: 0.25,
+                }),
+            ),
+            obstacle(
+                "ball",
+                Shape::Sphere(Sphere {
+                    center: [1.5, -0.5, 0.8],
+                    radius: 0.35,
+                }),
+            ),
+            obstacle(
+                "crate",
+                Shape::Box(OrientedBox {
+                    center: [-1.2, 0.4, 0.3],
+                    half: [0.3, 0.2, 0.25],
+                    axes: frame([1.0, 1.0, 0.0], [-1.0, 1.0, 0.5]).expect("independent axes"),
+                }),
+            ),
+            obstacle(
+                "floor",
+                Shape::HalfSpace(HalfSpace {
+                    point: [0.0, 0.0, -0.2],
+                    normal: [0.0, 0.0, 1.0],
+                }),
+            ),
+            obstacle("part", Shape::Mesh(octahedron.clone())),
+        ],
+        copies: Copies {
+            n: 3,
+            point: [0.0, 0.0, 0.0],
+            direction: [0.0, 0.6, 0.8],
+        },
+        containment: vec![Containment {
+            bounds: OrientedBox::aligned([-2.0, -2.0, -0.5], [2.0, 2.0, 2.5]),
+            t: None,
+            name: "workspace".into(),
+        }],
+    };
+    let goal = |goal: Goal, entry: usize| Target {
+        t: PI / 2.0,
+        vertex: VertexRef::Tip,
+        goal,
+        weight: 1.0,
+        entry,
+    };
+    meta.goals = vec![
+        goal(
+            Goal::Point {
+                point: [0.5, 0.0, 0.6],
+            },
+            0,
+        ),
+        goal(
+            Goal::Line {
+                point: [0.0, 0.0, 1.0],
+                direction: [1.0, 0.0, 0.0],
+            },
+            1,
+        ),
+        goal(
+            Goal::Plane {
+                point: [0.0, 0.0, 1.2],
+                normal: [0.0, 0.0, 1.0],
+            },
+            2,
+        ),
+        goal(Goal::Surface { index: 0 }, 3),
+    ];
+    meta.surfaces = vec![octahedron];
+    Ok((p, meta))
 }

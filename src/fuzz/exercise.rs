@@ -120,7 +120,7 @@ fn write_pattern(p: &Pattern, meta: &DesignMeta) {
     let _ = crate::export::fold::to_fold_string(p, meta, FoldSpec::default());
     let _ = svg::crease_pattern_svg(p, &svg::SvgOptions::default());
     let last = p.frames.len().checked_sub(1);
-    if let Ok(m) = mesh::state_mesh(p, last, meta.second_arm) {
+    if let Ok(m) = mesh::state_mesh_copies(p, last, &meta.scene.copies) {
         let _ = mesh::to_obj(&m, "fuzz");
         let _ = mesh::to_stl_binary(&m);
     }

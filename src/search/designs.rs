@@ -297,8 +297,17 @@ pub fn model_meta(task: &Task, model: &Model, modes: &[String], objective: f64) 
         } else {
             Vec::new()
         },
-        obstacle: task.scene.cylinders().next().copied(),
-        second_arm: task.scene.copies.n == 2,
+        scene: task.scene.clone(),
+        goals: task
+            .objective
+            .as_ref()
+            .map(|o| o.targets.clone())
+            .unwrap_or_default(),
+        surfaces: task
+            .objective
+            .as_ref()
+            .map(|o| o.surfaces.clone())
+            .unwrap_or_default(),
         extra: BTreeMap::new(),
     }
 }

@@ -116,6 +116,7 @@ async function detail(page) {
     selected: window.foldsynthReport.selected,
     frame: window.foldsynthReport.frame,
     webgl: window.foldsynthReport.webgl,
+    objects: window.foldsynthReport.objects,
     t: document.getElementById('t-value').textContent,
     slider: { min: document.getElementById('t-slider').min, max: document.getElementById('t-slider').max, value: document.getElementById('t-slider').value },
     title: document.getElementById('detail-title').textContent,

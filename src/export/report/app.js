@@ -19,6 +19,7 @@
     get frame() { return state.frame; },
     get webgl() { return state.webgl; },
     get sort() { return state.sort; },
+    get objects() { return view && view.names ? view.names() : []; },
   };
 
   // ---- table: sorting -------------------------------------------------------------------
@@ -297,6 +298,106 @@
       return g;
     }
 
+    // side 2 is three.js's DoubleSide (not among the bundle's exports).
+    const translucent = (color, opacity) => new T.MeshLambertMaterial({ color: color, transparent: true, opacity: opacity, depthWrite: false, side: 2 });
+
+    function meshGeometry(m) {
+      const g = new T.BufferGeometry();
+      g.setAttribute('position', new T.BufferAttribute(new Float32Array(m.vertices), 3));
+      g.setIndex(m.triangles);
+      g.computeVertexNormals();
+      return g;
+    }
+
+    // A square of half side h about point p, normal to the unit n (two triangles).
+    function square(p, nrm, h, material) {
+      const n3 = new T.Vector3().fromArray(nrm);
+      const helper = Math.abs(n3.x) < 0.9 ? new T.Vector3(1, 0, 0) : new T.Vector3(0, 1, 0);
+      const u = helper.cross(n3).normalize();
+      const v = n3.clone().cross(u);
+      const c = new T.Vector3().fromArray(p);
+      const corner = (a, b) => c.clone().add(u.clone().multiplyScalar(a * h)).add(v.clone().multiplyScalar(b * h)).toArray();
+      const vertices = [corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1)].flat();
+      return new T.Mesh(meshGeometry({ vertices: vertices, triangles: [0, 1, 2, 0, 2, 3] }), material);
+    }
+
+    // A box's 12 triangles from its 8 corners (corner k: + on axis i where bit i is set).
+    const BOX_TRIANGLES = [0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5];
+
+    // The point of the plane (p, n) nearest to c.
+    function foot(p, nrm, c) {
+      const n3 = new T.Vector3().fromArray(nrm);
+      const d = c.clone().sub(new T.Vector3().fromArray(p)).dot(n3);
+      return c.clone().sub(n3.multiplyScalar(d)).toArray();
+    }
+
+    // The 12 edges of a box given by its 8 corners (corner k: + on axis i where bit i is set).
+    function boxEdges(corners, color) {
+      const seg = [];
+      for (let k = 0; k < 8; k += 1) {
+        for (const bit of [1, 2, 4]) if (!(k & bit)) seg.push(corners[k], corners[k | bit]);
+      }
+      return new T.LineSegments(lineGeometry(seg), new T.LineBasicMaterial({ color: color }));
+    }
+
+    // Obstacles (grey, translucent), containment boxes (wireframes) and goals other than
+    // points (green): a line as a long segment, a plane as a square, a surface as its mesh.
+    // Each object is named kind:name so a test (or a person in the console) can find it.
+    function drawScene(world, goals, center, radius) {
+      const out = [];
+      const grey = () => translucent(0x8a8a8a, 0.35);
+      world.obstacles.forEach((o) => {
+        let obj = null;
+        if (o.shape === 'cylinder') {
+          const a = new T.Vector3().fromArray(o.a);
+          const b = new T.Vector3().fromArray(o.b);
+          const axis = b.clone().sub(a);
+          obj = new T.Mesh(new T.CylinderGeometry(o.radius, o.radius, axis.length(), 48, 1, false), grey());
+          obj.position.copy(a.clone().add(b).multiplyScalar(0.5));
+          obj.quaternion.setFromUnitVectors(new T.Vector3(0, 1, 0), axis.normalize());
+        } else if (o.shape === 'sphere') {
+          obj = new T.Mesh(new T.SphereGeometry(o.radius, 32, 16), grey());
+          obj.position.fromArray(o.center);
+        } else if (o.shape === 'box') {
+          obj = new T.Mesh(meshGeometry({ vertices: o.corners.flat(), triangles: BOX_TRIANGLES }), grey());
+        } else if (o.shape === 'halfspace') {
+          obj = square(foot(o.point, o.normal, center), o.normal, 1.5 * radius, grey());
+        } else if (o.shape === 'mesh' && o.mesh) {
+          obj = new T.Mesh(meshGeometry(o.mesh), grey());
+        }
+        if (obj) {
+          obj.name = 'obstacle:' + o.shape + ':' + o.name;
+          out.push(obj);
+        }
+      });
+      world.containment.forEach((c) => {
+        const box = boxEdges(c.corners, 0x6a3d9a);
+        box.name = 'containment:' + c.name;
+        out.push(box);
+      });
+      const green = () => translucent(0x2e8b57, 0.3);
+      goals.forEach((g, i) => {
+        let obj = null;
+        if (g.kind === 'line') {
+          // The line's point nearest the view's centre, ± two view radii along it.
+          const u0 = new T.Vector3().fromArray(g.direction);
+          const p0 = new T.Vector3().fromArray(g.point);
+          const p = p0.clone().add(u0.clone().multiplyScalar(center.clone().sub(p0).dot(u0)));
+          const u = new T.Vector3().fromArray(g.direction).multiplyScalar(2 * radius);
+          obj = new T.Line(lineGeometry([p.clone().sub(u).toArray(), p.clone().add(u).toArray()]), new T.LineBasicMaterial({ color: 0x2e8b57 }));
+        } else if (g.kind === 'plane') {
+          obj = square(foot(g.point, g.normal, center), g.normal, radius, green());
+        } else if (g.kind === 'surface' && world.surfaces[g.index]) {
+          obj = new T.Mesh(meshGeometry(world.surfaces[g.index]), green());
+        }
+        if (obj) {
+          obj.name = 'goal:' + g.kind + ':' + i;
+          out.push(obj);
+        }
+      });
+      return out;
+    }
+
     function show(d) {
       if (content) {
         scene.remove(content);
@@ -330,22 +431,42 @@
         }
         return group;
       };
-      content.add(arm(0xf0a860, 0x7fa7d9, 1));
-      if (d.second_arm) {
-        const second = arm(0xf7d2ad, 0xbcd0ea, 0.45);
-        second.rotation.z = Math.PI; // the thesis's two-armed gripper: the arm rotated 180° about z
-        content.add(second);
+      const first = arm(0xf0a860, 0x7fa7d9, 1);
+      first.name = 'arm:1';
+      content.add(first);
+      const world = (data.scenes && data.scenes[d.scene]) || { obstacles: [], copies: { n: 1 }, containment: [], surfaces: [] };
+      // Copy k: the arm turned by 2πk/n about the copies' axis (sharing the arm's geometry,
+      // so the t slider moves every copy).
+      // (The bundled three.js has no Matrix4: a copy is a quaternion and a position.)
+      const copies = [];
+      const cp = world.copies;
+      for (let k = 1; k < (cp.n || 1); k += 1) {
+        const axis = new T.Vector3().fromArray(cp.direction);
+        const angle = (2 * Math.PI * k) / cp.n;
+        const at = new T.Vector3().fromArray(cp.point);
+        const shift = at.clone().sub(at.clone().applyAxisAngle(axis, angle));
+        const copy = arm(0xf7d2ad, 0xbcd0ea, 0.45);
+        copy.name = 'arm:' + (k + 1);
+        copy.quaternion.setFromAxisAngle(axis, angle);
+        copy.position.copy(shift);
+        content.add(copy);
+        copies.push({ axis: axis, angle: angle, shift: shift });
       }
-      // Everything the view should frame: every frame of both arms, targets, obstacle.
+      // Everything the view should frame: every frame of every copy, targets, obstacles.
       const pts = [];
+      const v3 = new T.Vector3();
       for (const f of frames) {
         for (let i = 0; i < n; i += 1) {
           pts.push([f[3 * i], f[3 * i + 1], f[3 * i + 2]]);
-          if (d.second_arm) pts.push([-f[3 * i], -f[3 * i + 1], f[3 * i + 2]]);
+          for (const c of copies) pts.push(v3.set(f[3 * i], f[3 * i + 1], f[3 * i + 2]).applyAxisAngle(c.axis, c.angle).add(c.shift).toArray());
         }
       }
       for (const p of d.targets.concat(d.trajectory)) pts.push(p);
-      if (d.obstacle) pts.push(d.obstacle.a, d.obstacle.b);
+      for (const o of world.obstacles) {
+        if (o.shape === 'cylinder') pts.push(o.a, o.b);
+        else if (o.shape === 'sphere') pts.push(o.center);
+        else if (o.shape === 'box') pts.push(...o.corners);
+      }
       const lo = [0, 1, 2].map((k) => Math.min(...pts.map((p) => p[k])));
       const hi = [0, 1, 2].map((k) => Math.max(...pts.map((p) => p[k])));
       const center = new T.Vector3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
@@ -367,18 +488,7 @@
         marker = dot(0.022 * radius, 0x111111);
         content.add(marker);
       }
-      if (d.obstacle) {
-        const a = new T.Vector3().fromArray(d.obstacle.a);
-        const b = new T.Vector3().fromArray(d.obstacle.b);
-        const axis = b.clone().sub(a);
-        const cyl = new T.Mesh(
-          new T.CylinderGeometry(d.obstacle.radius, d.obstacle.radius, axis.length(), 48, 1, false),
-          new T.MeshLambertMaterial({ color: 0x8a8a8a, transparent: true, opacity: 0.35, depthWrite: false })
-        );
-        cyl.position.copy(a.clone().add(b).multiplyScalar(0.5));
-        cyl.quaternion.setFromUnitVectors(new T.Vector3(0, 1, 0), axis.normalize());
-        content.add(cyl);
-      }
+      for (const o of drawScene(world, d.goals || [], center, radius)) content.add(o);
       scene.add(content);
       current = { d: d, frames: frames, faceGeo: faceGeo, edgeGeo: edgeGeo, marker: marker, gv: gv, n: n };
       // Front, right, above: the folded arm and its target in view.
@@ -417,7 +527,12 @@
       render();
     }
 
-    return { show: show, setFrame: setFrame };
+    // Names of the objects in the view (arms, obstacles, boxes, goals), in drawing order.
+    function names() {
+      return content ? content.children.map((o) => o.name).filter((x) => x) : [];
+    }
+
+    return { show: show, setFrame: setFrame, names: names };
   }
 
   function setFrame(x) {

@@ -14,9 +14,12 @@
 //! gripping candidate and vertex, modes, Ω*, and the robustness margins when the records
 //! carry them) that sorts by any column and filters by level, modes, objective and
 //! margins, and for the selected design a three.js view of its folding motion (slider for
-//! t, play/pause, target points, trajectory, obstacle cylinder, the second arm of
-//! two-armed tasks, the gripping vertex and its path; rotate with the mouse) beside its
+//! t, play/pause, target points, trajectory, goal lines, planes and surfaces, obstacles of
+//! every shape, containment boxes, every copy of the arm, the gripping vertex and its
+//! path; rotate with the mouse) beside its
 //! crease pattern, with its figures and files below.
+
+mod scene_data;
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
@@ -336,8 +339,7 @@ fn design_json(out_dir: &Path, d: &ReportDesign) -> Result<Value> {
         "geometry": geometry_json(&d.pattern)?,
         "targets": m.targets.iter().map(|t| [r4(t.p[0]), r4(t.p[1]), r4(t.p[2])]).collect::<Vec<_>>(),
         "trajectory": m.trajectory.iter().map(|q| [r4(q[0]), r4(q[1]), r4(q[2])]).collect::<Vec<_>>(),
-        "obstacle": m.obstacle,
-        "second_arm": m.second_arm,
+        "goals": scene_data::goals_json(m),
     }))
 }
 
@@ -577,7 +579,8 @@ pub fn report_html(out_dir: &Path, input: &ReportInput) -> Result<String> {
     } else {
         sm.title.clone()
     };
-    let data = designs_data(out_dir, input)?;
+    let mut data = designs_data(out_dir, input)?;
+    let scenes = scenes_data(input, &mut data)?;
     let mut s = format!(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{}</title><style>{CSS}</style></head><body>\n<header><h1>{}</h1><div>task: {}</div></header>\n<main>\n",
         xml_escape(&title),
@@ -616,9 +619,32 @@ pub fn report_html(out_dir: &Path, input: &ReportInput) -> Result<String> {
     let _ = write!(
         s,
         "<script type=\"application/json\" id=\"foldsynth-data\">{}</script>\n<script>{THREE_JS}</script>\n<script>{APP_JS}</script>\n</body></html>\n",
-        script_json(&json!({ "designs": data }))
+        script_json(&json!({ "designs": data, "scenes": scenes }))
     );
     Ok(s)
+}
+
+/// The distinct scenes of the designs (usually one: a task's), each once with its meshes;
+/// every design's data gets `scene`, the index of its own.
+fn scenes_data(input: &ReportInput, data: &mut [Value]) -> Result<Vec<Value>> {
+    let mut seen: Vec<&DesignMeta> = Vec::new();
+    let mut scenes = Vec::new();
+    for (d, v) in input.designs.iter().zip(data.iter_mut()) {
+        let m = &d.meta;
+        let same = |o: &&DesignMeta| o.scene == m.scene && o.surfaces == m.surfaces;
+        let k = match seen.iter().position(same) {
+            Some(k) => k,
+            None => {
+                scenes.push(scene_data::scene_json(m).map_err(|e| {
+                    ExportError::invalid(format!("design {}", d.id), e.to_string())
+                })?);
+                seen.push(m);
+                seen.len() - 1
+            }
+        };
+        v["scene"] = json!(k);
+    }
+    Ok(scenes)
 }
 
 /// Every design's data for the page, its id unique and its metadata valid.
@@ -700,7 +726,7 @@ fn designs_section(designs: &[ReportDesign]) -> String {
 <div class=\"views\"><figure class=\"view3d\"><div id=\"view3d\"><canvas id=\"canvas3d\" width=\"640\" height=\"480\"></canvas><p id=\"no-webgl\" hidden>The 3D view needs WebGL, which this browser does not offer; the crease pattern and figures below still apply.</p></div>\
 <div class=\"controls\"><button type=\"button\" id=\"play\">play</button><input type=\"range\" id=\"t-slider\" min=\"0\" max=\"1\" step=\"0.01\" value=\"1\" aria-label=\"driving parameter t\"><output id=\"t-value\"></output></div>\
 <figcaption>folding motion: drag to rotate, wheel to zoom, right-drag to pan. Paper: orange front, blue back; red mountain, blue valley, grey flat creases; \
-black dot and line: the gripping vertex and its path; green: targets and trajectory; grey: obstacle; lighter: the second arm.</figcaption></figure>\
+black dot and line: the gripping vertex and its path; green: targets, trajectory, goal lines, planes and surfaces; grey: obstacles; purple: boxes to stay inside; lighter: the other copies of the arm.</figcaption></figure>\
 <figure class=\"cp\"><svg id=\"cp\" xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 100 100\" role=\"img\" aria-label=\"crease pattern\"></svg>\
 <figcaption>crease pattern: red mountain, blue valley, grey flat, black boundary, thick: driven crease; vertices v1, v2, … as in the rule sequence; circled: the gripping vertex</figcaption></figure></div>\
 <table class=\"facts\" id=\"detail-facts\"><tbody></tbody></table><p class=\"files\" id=\"detail-files\"></p></article></div>";
