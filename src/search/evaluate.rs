@@ -4,7 +4,9 @@
 //! design the sweep and the simulation) and, where every check passed, its robustness:
 //! one [`AlternativeRecord`] out.
 
-use super::measure::{checked_pattern, measure_robustness, obstacles};
+use super::measure::{
+    checked_pattern, judge_requirements, judged_times, measure_robustness, obstacles,
+};
 use super::options::{Alternative, SearchOptions};
 use super::record::AlternativeRecord;
 use crate::check::verify::{Tolerances, verify_folded};
@@ -14,7 +16,7 @@ use crate::cpu_time::Stopwatch;
 use crate::grammar::CreaseGraph;
 use crate::model::Model;
 use crate::model::compiled::{CompiledModel, ModelProblem, objective_target};
-use crate::model::numeric::{Evaluated, sample_times};
+use crate::model::numeric::Evaluated;
 use crate::model::robust::{Deferred, LazyBlock, RobustSpec};
 use crate::optimize::{self, SharedStarts, Solution, minimize_shared};
 use crate::pattern::Pattern;
@@ -186,6 +188,7 @@ fn optimized_record(
         optimize_ms,
         check_ms: 0.0,
         cycle: None,
+        requirements: None,
     }
 }
 
@@ -201,7 +204,8 @@ fn judge(
     // The judges run on the dense verification sweep, not only on the states the optimizer
     // saw, so an intersection between sampled states cannot hide.
     // Each state folded once, for the pattern the checks judge and for `verify`.
-    let sweep = sample_times(model.t_max, opts.sweep);
+    // With the states the task's terms name (the sweep's own for the bundled thesis tasks).
+    let sweep = judged_times(task, model.t_max, opts.sweep);
     let folds = design.fold_all(&sweep);
     let arm = design.pattern_of(&sweep, &folds);
     let mut checked_pattern = None;
@@ -249,6 +253,17 @@ fn judge(
         rec.verification_failed = Some(failed);
     }
     rec.verification = Some(report);
+    match judge_requirements(task, model, &arm) {
+        Ok(r) => rec.requirements = Some(r),
+        Err(e) => {
+            // Nothing measured cannot pass: the design is not reported as one.
+            eprintln!(
+                "warning: {}: the requirements could not be judged: {e}",
+                rec.key
+            );
+            rec.verification_failed = Some(true);
+        }
+    }
     // Margins are a design's: measured only where every check passed (with
     // `--post-check-only` most target-meeting alternatives fail one, and measuring them was
     // half of that run's check time; issue 14).

@@ -2,6 +2,7 @@
 //! copy for two-armed tasks), the task's obstacles, and the design's robustness measured
 //! by `check::robustness` (for a new design and for a recorded one alike).
 
+use crate::check::requirements::{self, JudgeInput, RequirementsReport};
 use crate::check::robustness::{self, RobustnessInput, RobustnessReport, UnitCreases};
 use crate::check::{Cylinder, two_armed};
 use crate::model::Model;
@@ -91,4 +92,88 @@ pub(super) fn measure_robustness(
         arm,
     };
     robustness::measure(&input).map_err(|e| e.to_string())
+}
+
+/// The states the judges look at: the dense sweep of `n` states, with every t a term of
+/// the task names (targets, orientations, containment boxes, the packing term) that the
+/// sweep does not already hold within [`T_TOL`](crate::check::requirements::T_TOL), so a
+/// requirement at t = π/8 is judged at π/8 itself.
+pub(super) fn judged_times(task: &Task, t_max: f64, n: usize) -> Vec<f64> {
+    use crate::task::terms::AreaKind;
+    let mut times = crate::model::numeric::sample_times(t_max, n);
+    let objective = task.objective.as_ref();
+    let named = objective
+        .into_iter()
+        .flat_map(|o| o.targets.iter().map(|t| t.t))
+        .chain(objective.and_then(|o| match o.area.as_ref()?.kind {
+            AreaKind::Packing { t } => Some(t),
+            AreaKind::Flat => None,
+        }))
+        .chain(
+            task.requirements
+                .orientations
+                .iter()
+                .flat_map(|o| o.t.clone()),
+        )
+        .chain(task.scene.containment.iter().filter_map(|c| c.t));
+    let near =
+        |a: f64, b: f64| (a - b).abs() <= crate::check::requirements::T_TOL * (1.0 + b.abs());
+    let extra: Vec<f64> = named
+        .filter(|&t| !times.iter().any(|&s| near(s, t)))
+        .collect();
+    if !extra.is_empty() {
+        times.extend(extra);
+        times.sort_by(f64::total_cmp);
+        times.dedup_by(|a, b| near(*a, *b));
+    }
+    times
+}
+
+/// The task's requirements, obstacles, copies, targets and area judged on the design's
+/// sweep (`arm`: the arm with its frames) by `check::requirements`; the vertices and
+/// creases the task names resolved in the model's plan (pattern indices are plan indices).
+pub(super) fn judge_requirements(
+    task: &Task,
+    model: &Model,
+    arm: &Pattern,
+) -> Result<RequirementsReport, String> {
+    use crate::model::select;
+    let plan = &model.plan;
+    let tip = model.gripping;
+    let ends = |c: usize| (plan.creases[c].tail, plan.creases[c].head);
+    let orientation_creases = task
+        .requirements
+        .orientations
+        .iter()
+        .map(|o| {
+            let v = select::vertex(plan, tip, &o.vertex)?;
+            select::crease_into(plan, v).map(ends)
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    let fold_limit_creases = task
+        .requirements
+        .fold_limits
+        .iter()
+        .map(|l| select::crease(plan, tip, &l.crease).map(ends))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    let target_vertices = task
+        .objective
+        .iter()
+        .flat_map(|o| &o.targets)
+        .map(|t| select::vertex(plan, tip, &t.vertex))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| e.to_string())?;
+    let input = JudgeInput {
+        arm,
+        scene: &task.scene,
+        requirements: &task.requirements,
+        objective: task.objective.as_ref(),
+        orientation_creases,
+        fold_limit_creases,
+        target_vertices,
+        obstacle_clearance: task.robustness.obstacle_clearance,
+    };
+    requirements::judge(&input).map_err(|e| e.to_string())
 }

@@ -80,6 +80,10 @@ pub struct AlternativeRecord {
     /// sweep and the bar-and-hinge simulation, which decide whether the design folds.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle: Option<crate::simulate::crossval::CyclicVerdict>,
+    /// For designs that meet the target: the task's requirements, obstacles, copies,
+    /// targets and area judged again on the dense sweep by `check::requirements` (issue 31).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub requirements: Option<crate::check::requirements::RequirementsReport>,
 }
 
 impl AlternativeRecord {
@@ -101,6 +105,7 @@ impl AlternativeRecord {
                 .is_some_and(|v| v.rigid_over_motion)
             && self.verification_failed == Some(false)
             && self.cycle.as_ref().is_none_or(|c| c.passes)
+            && self.requirements.as_ref().is_none_or(requirements_hold)
     }
 
     /// Whether the margins the run requires hold on the sweep. With the robustness
@@ -115,6 +120,36 @@ impl AlternativeRecord {
         self.robustness
             .as_ref()
             .is_some_and(|r| r.margins().all(|m| m.setting == 0.0) || r.meets_settings())
+            && self.requirement_margins_short().is_empty()
+    }
+
+    /// The clearances to obstacles of the new shapes and to the walls of containment boxes
+    /// short of `obstacle_clearance` on the sweep (cylinders are measured by
+    /// `check::robustness` with the other margins).
+    fn requirement_margins_short(&self) -> Vec<String> {
+        let Some(r) = &self.requirements else {
+            return Vec::new();
+        };
+        let obstacles = r
+            .obstacles
+            .iter()
+            .filter(|o| o.kind != "cylinder" && !o.holds)
+            .map(|o| (o.name.as_str(), o.least, o.clearance, o.t));
+        let boxes = r
+            .containment
+            .iter()
+            .filter(|c| !c.holds)
+            .map(|c| (c.name.as_str(), c.least, c.clearance, c.t));
+        obstacles
+            .chain(boxes)
+            .map(|(name, least, setting, t)| {
+                let at = t.map(|t| format!(" at t {t:.4}")).unwrap_or_default();
+                match least {
+                    Some(v) => format!("{name}: clearance {v:.3e} < {setting:.3e}{at}"),
+                    None => format!("{name}: clearance not measured"),
+                }
+            })
+            .collect()
     }
 
     /// The required margins short of their setting on the sweep (see
@@ -127,6 +162,7 @@ impl AlternativeRecord {
         let Some(r) = &self.robustness else {
             return vec!["the robustness measurement failed".into()];
         };
+        let mut short = self.requirement_margins_short();
         let named = [
             ("rigid_margin", Some(&r.rigid_margin)),
             ("self_clearance", r.self_clearance.as_ref()),
@@ -134,18 +170,20 @@ impl AlternativeRecord {
             ("obstacle_clearance", r.obstacle_clearance.as_ref()),
             ("min_feature", r.min_feature.as_ref()),
         ];
-        named
-            .into_iter()
-            .filter_map(|(name, m)| m.map(|m| (name, m)))
-            .filter(|(_, m)| m.value < m.setting)
-            .map(|(name, m)| {
-                let at = m.t.map(|t| format!(" at t {t:.4}")).unwrap_or_default();
-                format!(
-                    "{name} {:.3e} < {:.3e}{at} ({})",
-                    m.value, m.setting, m.location
-                )
-            })
-            .collect()
+        short.extend(
+            named
+                .into_iter()
+                .filter_map(|(name, m)| m.map(|m| (name, m)))
+                .filter(|(_, m)| m.value < m.setting)
+                .map(|(name, m)| {
+                    let at = m.t.map(|t| format!(" at t {t:.4}")).unwrap_or_default();
+                    format!(
+                        "{name} {:.3e} < {:.3e}{at} ({})",
+                        m.value, m.setting, m.location
+                    )
+                }),
+        );
+        short
     }
 
     /// Passes every check and keeps the margins the run requires: what foldsynth reports
@@ -499,4 +537,19 @@ impl Summary {
         );
         s
     }
+}
+
+/// Whether the hard requirements hold on the sweep: every orientation and fold limit, every
+/// vertex inside its containment boxes, no obstacle hit, no crossing between copies. The
+/// clearances (to obstacles, box walls, between copies) are margins, judged with the others
+/// in [`AlternativeRecord::margins_hold`]; the targets and the area are the optimizer's
+/// verdict (`meets_target`), recomputed in the report for the reader.
+pub fn requirements_hold(r: &crate::check::requirements::RequirementsReport) -> bool {
+    r.orientations.iter().all(|o| o.holds)
+        && r.max_fold.iter().chain(&r.fold_limits).all(|f| f.holds)
+        && r.containment
+            .iter()
+            .all(|c| c.least.is_some_and(|d| d >= 0.0))
+        && r.obstacles.iter().all(|o| o.least.is_some() && !o.hit)
+        && r.copies.as_ref().is_none_or(|c| c.crossings == 0)
 }
