@@ -68,6 +68,11 @@ fn hinge(ts: &[f64]) -> Pattern {
     }
 }
 
+/// Whether two points agree to 1e-12 in every coordinate.
+fn close(a: [f64; 3], b: [f64; 3]) -> bool {
+    a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-12)
+}
+
 const TS: [f64; 4] = [0.0, 0.5, 1.2, 0.9];
 
 #[test]
@@ -106,9 +111,7 @@ fn orientation_of_the_folding_facet() {
     // at π/2 − t from +x.
     let n = pointer_direction(&p, &p.frames[2].coords, Pointer::FacetLeft, 0, 3).unwrap();
     let want = [1.2f64.sin(), 0.0, 1.2f64.cos()];
-    for i in 0..3 {
-        assert!((n[i] - want[i]).abs() < 1e-12, "{n:?}");
-    }
+    assert!(close(n, want), "{n:?}");
     // The right facet stays flat, normal +z.
     let n = pointer_direction(&p, &p.frames[2].coords, Pointer::FacetRight, 0, 3).unwrap();
     assert!((n[2] - 1.0).abs() < 1e-15);
@@ -365,9 +368,7 @@ fn three_copies_collide_two_do_not() {
     let (s, c) = (2.0 * PI / 3.0).sin_cos();
     let q = three.pattern.frames[0].coords[three.index[1][0]];
     let want = [c * 0.5 + s * 2.0, s * 0.5 - c * 2.0, -1.0];
-    for i in 0..3 {
-        assert!((q[i] - want[i]).abs() < 1e-12, "{q:?} vs {want:?}");
-    }
+    assert!(close(q, want), "{q:?} vs {want:?}");
     let x = copy_crossings(&three).unwrap();
     // Every pair of the three copies crosses.
     assert_eq!(x.len(), 3, "{x:?}");
@@ -403,12 +404,9 @@ fn copies_share_the_vertices_on_the_axis() {
     assert_eq!(c.pattern.faces.len(), 8);
     for fr in &c.pattern.frames {
         for k in 0..4 {
-            for i in 0..6 {
-                let a = copies.apply(k, p.frames.iter().find(|f| f.t == fr.t).unwrap().coords[i]);
-                let b = fr.coords[c.index[k][i]];
-                for j in 0..3 {
-                    assert!((a[j] - b[j]).abs() < 1e-12);
-                }
+            let arm = &p.frames.iter().find(|f| f.t == fr.t).unwrap().coords;
+            for (i, x) in arm.iter().enumerate() {
+                assert!(close(copies.apply(k, *x), fr.coords[c.index[k][i]]));
             }
         }
     }

@@ -88,9 +88,9 @@ fn random_box(rnd: &mut impl FnMut() -> f64) -> OrientedBox {
 fn box_distance(b: &OrientedBox, p: V) -> f64 {
     let d = p - V::from(b.center);
     let mut s = 0.0;
-    for i in 0..3 {
-        let x = d.dot(&V::from(b.axes[i]));
-        let c = x.clamp(-b.half[i], b.half[i]);
+    for (axis, h) in b.axes.iter().zip(&b.half) {
+        let x = d.dot(&V::from(*axis));
+        let c = x.clamp(-h, *h);
         s += (x - c) * (x - c);
     }
     s.sqrt()

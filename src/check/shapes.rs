@@ -72,8 +72,8 @@ pub fn halfspace_clearance(h: &HalfSpace, t: &Tri) -> f64 {
 pub fn point_box_distance(b: &OrientedBox, p: &V) -> f64 {
     let q = b.local([p.x, p.y, p.z]);
     let mut s = 0.0;
-    for i in 0..3 {
-        let d = q[i].abs() - b.half[i];
+    for (x, h) in q.iter().zip(&b.half) {
+        let d = x.abs() - h;
         if d > 0.0 {
             s += d * d;
         }
