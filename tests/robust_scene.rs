@@ -587,7 +587,7 @@ fn new_constraints_gradients_match_central_differences() {
 fn three_and_four_copies_keep_their_clearance() {
     let task = Task::load(GRIPPER).unwrap();
     let mut verdicts = [0usize; 2];
-    for n in [3, 4] {
+    for (n, clearance) in [(3, 0.05), (4, 0.05), (3, 0.5), (4, 0.5)] {
         for shift in [0.0, 0.25, 0.5] {
             for (model, x, modes) in models(&task, 4, shift) {
                 let mut spec = spec_with(
@@ -597,9 +597,8 @@ fn three_and_four_copies_keep_their_clearance() {
                         ..Scene::default()
                     },
                 );
-                spec.settings.clearance = 0.05;
+                spec.settings.clearance = clearance;
                 let block = RobustModel::new(&model, spec).unwrap();
-                let clearance = 0.05;
                 let plan = &model.plan;
                 let on_axis = |v: usize| matches!(plan.vertices[v].position, Position::Fixed(p) if p[0].hypot(p[1]) < 1e-9);
                 let tip = block
