@@ -133,6 +133,8 @@ fn time_index(model: &Model, t: f64) -> usize {
 /// ([`Model::surface_terms`]). The thesis's operations in the thesis's order for point
 /// targets: one target `w² d²`, several `0 + Σ w √(d² + ε²)`.
 pub(super) fn omega<S: Scalar>(model: &Model, flat: &Flat<S>, folded: &[Folded<S>]) -> S {
+    // Every squared distance first, then the combination: the order the thesis's code
+    // built its expressions in (the compiled graph of a bundled task stays the same).
     let mut terms = Vec::with_capacity(model.targets.len());
     for target in &model.targets {
         let x = geometry::position(
@@ -142,12 +144,18 @@ pub(super) fn omega<S: Scalar>(model: &Model, flat: &Flat<S>, folded: &[Folded<S
             target.vertex,
         );
         if let Some(d2) = squared_distance(&x, &target.goal) {
-            terms.push(model.combination.term(target.weight, d2));
+            terms.push((target.weight, d2));
         }
     }
-    match model.combination {
-        Combination::Squared => terms.into_iter().next().unwrap_or_else(|| S::from_f64(0.0)),
-        Combination::Smoothed => terms.into_iter().fold(S::from_f64(0.0), |acc, t| acc + t),
+    let c = model.combination;
+    match c {
+        Combination::Squared => terms
+            .into_iter()
+            .next()
+            .map_or_else(|| S::from_f64(0.0), |(w, d2)| c.term(w, d2)),
+        Combination::Smoothed => terms
+            .into_iter()
+            .fold(S::from_f64(0.0), |acc, (w, d2)| acc + c.term(w, d2)),
     }
 }
 
