@@ -253,9 +253,15 @@ fn judge(
         rec.verification_failed = Some(failed);
     }
     rec.verification = Some(report);
-    match judge_requirements(task, model, &arm) {
-        Ok(r) => rec.requirements = Some(r),
-        Err(e) => {
+    // Judged where the layout could be checked (a layout that cannot be triangulated
+    // already fails as a self-intersection).
+    match checked_pattern
+        .as_ref()
+        .map(|_| judge_requirements(task, model, &arm))
+    {
+        None => {}
+        Some(Ok(r)) => rec.requirements = Some(r),
+        Some(Err(e)) => {
             // Nothing measured cannot pass: the design is not reported as one.
             eprintln!(
                 "warning: {}: the requirements could not be judged: {e}",
