@@ -143,6 +143,7 @@ fn build_design(
         "self_intersection_free": rec.self_intersection_free,
         "obstacle_free": rec.obstacle_free,
         "robustness": rec.robustness,
+        "requirements": rec.requirements,
         "rank": rank,
         "pattern": pattern,
         "meta": meta,
