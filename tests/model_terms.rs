@@ -88,13 +88,8 @@ fn check_compiled_and_gradients(model: &Model, x: &[f64], modes: &[f64]) -> Eval
     let (f, g) = outputs_f64(model, x, modes);
     assert_eq!(g.len(), m);
     assert!(close(e.f, f, 1e-12), "objective {} vs {f}", e.f);
-    for k in 0..m {
-        assert!(
-            close(e.g[k], g[k], 1e-12),
-            "constraint {k}: {} vs {}",
-            e.g[k],
-            g[k]
-        );
+    for (k, (got, want)) in e.g.iter().zip(&g).enumerate() {
+        assert!(close(*got, *want, 1e-12), "constraint {k}: {got} vs {want}");
     }
     for i in 0..n {
         let h = 1e-6 * (1.0 + x[i].abs());

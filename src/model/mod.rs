@@ -159,7 +159,7 @@ impl Model {
             surfaces: resolved.surfaces,
             orientations: resolved.orientations,
             area: objective.area,
-            copies: task.scene.copies.clone(),
+            copies: task.scene.copies,
             threshold: objective.threshold,
             candidate,
             gripping,
