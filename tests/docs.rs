@@ -827,7 +827,15 @@ impl PageRun<'_> {
             },
         };
         self.report.ran += 1;
-        let loaded = foldsynth::task::Task::from_toml_str(&text, &b.at);
+        // A fragment of a task file reads its mesh files from that file's folder.
+        let dir = match &base {
+            Some(file) => Path::new(ROOT)
+                .join(file)
+                .parent()
+                .map_or_else(|| PathBuf::from(ROOT), Path::to_path_buf),
+            None => PathBuf::from(ROOT),
+        };
+        let loaded = foldsynth::task::Task::from_toml_str_in(&text, &b.at, &dir);
         let rejects = b.notes.iter().find_map(|n| match n {
             Note::Rejects(f) => Some(f.clone()),
             _ => None,

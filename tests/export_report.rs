@@ -71,6 +71,7 @@ fn sample_designs() -> Vec<ReportDesign> {
         pattern,
         meta,
         robustness,
+        area: None,
         facts: vec![Fact::new("note", "a \"quoted\" <value>")],
         design_file: None,
         files: None,
@@ -830,6 +831,7 @@ fn report_draws_every_shape_of_the_scene_once() {
         pattern: p.clone(),
         meta: meta.clone(),
         robustness: None,
+        area: Some(2.5),
         facts: Vec::new(),
         design_file: None,
         files: None,
@@ -884,6 +886,8 @@ fn report_draws_every_shape_of_the_scene_once() {
     assert_eq!(s["containment"][0]["corners"].as_array().unwrap().len(), 8);
     // The mesh is embedded once (as the obstacle and the surface), not per design.
     assert_eq!(html.matches("\"triangles\":[").count(), 2);
+    // An area task's designs get the area column (the other report has none).
+    assert!(html.contains("<th data-key=\"area\""));
 
     // A missing mesh file: no report, an error naming it.
     std::fs::remove_file(dir.path().join("octahedron.obj")).unwrap();

@@ -320,6 +320,11 @@ pub(super) fn report_design(
         pattern,
         meta,
         robustness: robustness(rec),
+        area: rec
+            .requirements
+            .as_ref()
+            .and_then(|r| r.area.as_ref())
+            .and_then(|a| a.value),
         facts,
         design_file: Some(design_file),
         files,

@@ -117,6 +117,9 @@ pub struct ReportDesign {
     /// `self_clearance`, `arm_clearance`, `obstacle_clearance`, `min_feature`, each
     /// `{value, setting, t, where}` or null); `None` when not computed.
     pub robustness: Option<Value>,
+    /// The area of an area task (`[objective.area]`: flat, or flat over the folded
+    /// footprint), as the independent check measured it: a column of the table.
+    pub area: Option<f64>,
     /// Further figures shown below the views (verification, variables, …).
     pub facts: Vec<Fact>,
     /// The design JSON (`designs/<id>.json`), when written.
@@ -396,6 +399,9 @@ fn columns(designs: &[ReportDesign]) -> Vec<Column> {
         col("modes", "modes", Filter::Choice, false),
         col("objective", "Ω*", Filter::AtMost, true),
     ];
+    if designs.iter().any(|d| d.area.is_some()) {
+        cols.push(col("area", "area", Filter::AtLeast, true));
+    }
     let robust = |key: &str| {
         designs
             .iter()
@@ -435,6 +441,10 @@ fn cells(d: &ReportDesign, cols: &[Column]) -> Vec<Cell> {
             "modes" => cell(modes_text(m), json!(modes_text(m))),
             "objective" => match m.objective {
                 Some(o) => cell(format!("{o:.2e}"), json!(o)),
+                None => cell("–", Value::Null),
+            },
+            "area" => match d.area {
+                Some(a) => cell(num(a), json!(a)),
                 None => cell("–", Value::Null),
             },
             "score" => match d
