@@ -376,7 +376,9 @@ fn bad_design_files_get_clear_errors() {
             "pattern.frames[1].coords",
         ),
         (
+            // A file from before the scene (no `scene`, a legacy `obstacle`).
             Box::new(|v| {
+                v["meta"].as_object_mut().unwrap().remove("scene");
                 v["meta"]["obstacle"] = serde_json::json!({"a": [0,0,0], "b": [0,1,0], "radius": 0})
             }),
             "meta.obstacle.radius",
