@@ -55,23 +55,7 @@ pub fn interface(
         },
         default: t,
     }));
-    let mut outputs = vec!["objective".to_string()];
-    outputs.extend((0..m).map(|k| model.constraint_label(k)));
-    outputs.extend(
-        model
-            .targets
-            .iter()
-            .filter(|t| t.surface().is_some())
-            .enumerate()
-            .flat_map(|(j, t)| {
-                ["x", "y", "z"].map(|c| {
-                    format!(
-                        "aux {j}: {c} of v{} at t = {} (surface target; its distance is added outside)",
-                        model.plan.vertices[t.vertex].name, t.t
-                    )
-                })
-            }),
-    );
+    let outputs = output_names(model, m);
     let objective = if model.area.is_some() {
         "-weight * A, the area term to maximize (the targets' Omega <= threshold is a constraint)"
     } else if model.targets.len() == 1 {
@@ -104,12 +88,49 @@ pub fn interface(
         "at which the model folds; NAME_default_params() gives those this library was made with."
             .replace("NAME", name),
     ];
+    let constants = constants(model, m, n, n_out);
+    Interface {
+        name: name.to_string(),
+        doc,
+        vars,
+        params,
+        outputs,
+        constants,
+    }
+}
+
+/// The names of the outputs before the gradients: the objective, each constraint's label,
+/// and the surface targets' positions (`m` constraints).
+fn output_names(model: &Model, m: usize) -> Vec<String> {
+    let mut outputs = vec!["objective".to_string()];
+    outputs.extend((0..m).map(|k| model.constraint_label(k)));
+    outputs.extend(
+        model
+            .targets
+            .iter()
+            .filter(|t| t.surface().is_some())
+            .enumerate()
+            .flat_map(|(j, t)| {
+                ["x", "y", "z"].map(|c| {
+                    format!(
+                        "aux {j}: {c} of v{} at t = {} (surface target; its distance is added outside)",
+                        model.plan.vertices[t.vertex].name, t.t
+                    )
+                })
+            }),
+    );
+    outputs
+}
+
+/// The library's constants: counts and the offsets of the output layout (`m` constraints,
+/// `n` variables, `n_out` outputs before the gradients).
+fn constants(model: &Model, m: usize, n: usize, n_out: usize) -> Vec<Constant> {
     let c = |name: &str, value: usize, doc: &str| Constant {
         name: name.into(),
         value,
         doc: doc.into(),
     };
-    let constants = vec![
+    vec![
         c("n_constraints", m, "constraints g_k >= 0"),
         c(
             "n_modes",
@@ -137,15 +158,7 @@ pub fn interface(
             n_out + n,
             "out[JACOBIAN_OFFSET + k*N_VARS + i]: d g_k / d vars[i]",
         ),
-    ];
-    Interface {
-        name: name.to_string(),
-        doc,
-        vars,
-        params,
-        outputs,
-        constants,
-    }
+    ]
 }
 
 /// The manifest: [`aot::manifest`] plus a `model` object (task, graph, candidate,
