@@ -10,7 +10,8 @@
 //!   the triangles near it; whether a closed mesh's inside holds a whole facet is left to
 //!   the independent judge).
 
-use crate::geom::{V3, add, cross, dot, norm, scale, sub};
+use crate::geom::{V3, add, dot, norm, scale, sub};
+use crate::model::surface::closest_on_triangle;
 use crate::scene::{HalfSpace, OrientedBox, Scene, Shape};
 
 /// The hull of a convex piece's points, for the exact distance from a point to it.
@@ -86,7 +87,7 @@ impl Convex {
             }
             Hull::Triangle => {
                 let [a, b, t] = [self.points[0], self.points[1], self.points[2]];
-                norm(sub(c, closest_on_triangle(c, a, b, t)))
+                norm(sub(c, closest_on_triangle(c, &[a, b, t])))
             }
         }
     }
@@ -101,61 +102,6 @@ impl Convex {
                 .any(|r| *r == q || norm(sub(*r, q)) <= tol)
         })
     }
-}
-
-/// The point of triangle `abc` nearest `p` (Ericson, Real-Time Collision Detection 5.1.5).
-pub fn closest_on_triangle(p: V3, a: V3, b: V3, c: V3) -> V3 {
-    let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
-    let (d1, d2) = (dot(ab, ap), dot(ac, ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = sub(p, b);
-    let (d3, d4) = (dot(ab, bp), dot(ac, bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return add(a, scale(ab, d1 / (d1 - d3)));
-    }
-    let cp = sub(p, c);
-    let (d5, d6) = (dot(ab, cp), dot(ac, cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return add(a, scale(ac, d2 / (d2 - d6)));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return add(b, scale(sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
-    }
-    let n = cross(ab, ac);
-    if dot(n, n) == 0.0 {
-        // Degenerate (no area): the nearest point of its three edges.
-        let on = |u: V3, v: V3| {
-            let e = sub(v, u);
-            let l = dot(e, e);
-            let s = if l > 0.0 {
-                (dot(sub(p, u), e) / l).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            add(u, scale(e, s))
-        };
-        let d = |q: V3| norm(sub(p, q));
-        let mut best = on(a, b);
-        for q in [on(b, c), on(c, a)] {
-            if d(q) < d(best) {
-                best = q;
-            }
-        }
-        return best;
-    }
-    let denom = 1.0 / (va + vb + vc);
-    add(a, add(scale(ab, vb * denom), scale(ac, vc * denom)))
 }
 
 /// The obstacles of a scene as the block sees them: the convex pieces (in the scene's
