@@ -40,6 +40,7 @@ mod constraints;
 mod ctx;
 mod drive;
 mod initial;
+pub mod fabrication;
 mod meshes;
 mod mirror;
 mod motion;
