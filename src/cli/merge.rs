@@ -1,8 +1,9 @@
-//! `foldsynth merge SHARD_DIR… --out DIR [--jobs N] [--no-export] [--force] [--json]`:
+//! `foldsynth merge SHARD_DIR… --out DIR [--jobs N] [--export N|all | --no-export] [--force] [--json]`:
 //! the shards of one search merged into the run one machine would have written.
 
 use crate::distribute::merge::{self, MergeOptions};
 use crate::limits;
+use crate::search::ExportCount;
 use anyhow::Result;
 use std::path::PathBuf;
 
@@ -18,9 +19,14 @@ pub struct MergeArgs {
     /// Worker threads for the designs and exports, 0 (one per core) to 256.
     #[arg(long, default_value_t = 0, value_parser = limits::count::<0, { limits::JOBS_MAX as u64 }>)]
     pub jobs: usize,
-    /// Skip the FOLD/SVG/OBJ/STL/picture/animation files and the report.
-    #[arg(long)]
+    /// Skip the FOLD/SVG/OBJ/STL/picture/animation files (the design JSONs and the report
+    /// are written either way).
+    #[arg(long, conflicts_with = "export")]
     pub no_export: bool,
+    /// Write the files of the N most robust designs (default 20), or of every design with
+    /// `all` (see synthesize --export).
+    #[arg(long, value_name = "N|all", default_value_t = ExportCount(Some(crate::search::EXPORT_TOP)), value_parser = clap::value_parser!(ExportCount))]
+    pub export: ExportCount,
     /// Use OUT even if it holds a run of other settings (see synthesize --force).
     #[arg(long)]
     pub force: bool,
@@ -38,6 +44,7 @@ pub fn run(args: MergeArgs) -> Result<()> {
             force: args.force,
             jobs: args.jobs,
             export: !args.no_export,
+            export_top: args.export.0,
         },
     )?;
     if args.json {

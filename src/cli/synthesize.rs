@@ -1,10 +1,10 @@
 //! `foldsynth synthesize TASK [--out DIR] [--jobs N] [--starts K] [--seed S] [--resume]
-//! [--force] [--shard K/N]`: the whole method on a design task, or one shard of it.
+//! [--force] [--export N|all | --no-export] [--shard K/N]`: the whole method on a design task, or one shard of it.
 
 use crate::distribute;
 use crate::limits;
 use crate::search::output::ShardSpec;
-use crate::search::{self, SearchOptions, output};
+use crate::search::{self, ExportCount, SearchOptions, output};
 use crate::task::Task;
 use anyhow::Result;
 use std::path::PathBuf;
@@ -44,8 +44,13 @@ pub struct SynthesizeArgs {
     pub sweep: usize,
     /// Skip the per-design FOLD/SVG/OBJ/STL/picture/animation files (the design JSONs and
     /// report.html, with its 3D views, are written either way).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "export")]
     pub no_export: bool,
+    /// Write the FOLD/SVG/OBJ/STL/picture/animation files of the N most robust designs
+    /// (default 20), or of every design with `all`; report.html gives the command that
+    /// writes any other design's files.
+    #[arg(long, value_name = "N|all", default_value_t = ExportCount(Some(search::EXPORT_TOP)), value_parser = clap::value_parser!(ExportCount))]
+    pub export: ExportCount,
     /// Run only shard K of N (1 ≤ K ≤ N) of the search: a deterministic, cost-balanced
     /// share of its models, into its own directory (records only; `foldsynth merge` makes
     /// the whole run of all N). Resumable with --resume like a whole run.
@@ -83,6 +88,7 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         n_max: args.n_max,
         sweep: args.sweep,
         export: !args.no_export,
+        export_top: args.export.0,
         progress: true,
         rules: args.rules,
         post_check_only: args.post_check_only,
@@ -117,11 +123,20 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         return Ok(());
     }
     let summary = search::run(&task, &opts)?;
-    let files = format!(
-        "report: {}\nsummary: {}\n",
+    let mut files = format!(
+        "report: {}\nsummary: {}\nrecords: {} (and alternatives.parquet)\n",
         out.join("report.html").display(),
-        out.join("summary.json").display()
+        out.join("summary.json").display(),
+        out.join(output::RECORDS).display(),
     );
+    if let (true, Some(n)) = (opts.export, opts.export_top)
+        && summary.designs.len() > n
+    {
+        files += &format!(
+            "design files: the FOLD file of each of the {} designs; SVG, meshes, pictures and animation of the {n} most robust (--export all: of every design; the report gives the command for any one)\n",
+            summary.designs.len()
+        );
+    }
     if args.json {
         // stdout stays one JSON document; the file names go to stderr.
         println!("{}", serde_json::to_string_pretty(&summary)?);

@@ -40,8 +40,11 @@ pub struct MergeOptions {
     pub force: bool,
     /// Worker threads for the designs and exports (0: one per core).
     pub jobs: usize,
-    /// Write FOLD/SVG/OBJ/STL/pictures/GIF and the report.
+    /// Write FOLD/SVG/OBJ/STL/pictures/GIF (the design JSONs and the report are written
+    /// either way).
     pub export: bool,
+    /// With `export`, of only this many most robust designs (`None`: all).
+    pub export_top: Option<usize>,
 }
 
 /// One shard directory, read.
@@ -390,6 +393,7 @@ fn search_options(
         n_max: Some(settings.n_max),
         sweep: settings.sweep,
         export: opts.export,
+        export_top: opts.export_top,
         progress: false,
         rules,
         post_check_only: settings.post_check_only,

@@ -12,7 +12,7 @@ use super::readback::read_at;
 use super::record::AlternativeRecord;
 use super::report::report_design;
 use crate::check::robustness::RobustnessReport;
-use crate::export::report::ReportDesign;
+use crate::export::report::{Fact, ReportDesign};
 use crate::export::{self, DesignMeta, ExportOptions};
 use crate::grammar::CreaseGraph;
 use crate::model::Model;
@@ -43,11 +43,12 @@ pub(super) fn write_designs(
         .num_threads(opts.jobs)
         .build()
         .map_err(|e| SearchError::Export(e.to_string()))?;
+    let what = |rank: usize| files_of(opts, rank);
     progress.phase(
-        if opts.export {
-            "write designs and their files"
-        } else {
-            "write design JSONs"
+        match what(1) {
+            Written::All => "write designs and their files",
+            Written::Fold => "write designs and their FOLD files",
+            Written::None => "write design JSONs",
         },
         "designs",
         Some(feasible.len() as u64),
@@ -70,16 +71,32 @@ pub(super) fn write_designs(
             .iter()
             .map(|w| out_dir.path(&format!("designs/{}.json", w.id)))
             .collect();
-        if opts.export {
-            let dirs: Vec<String> = work.iter().map(|w| format!("designs/{}", w.id)).collect();
-            for (w, dir) in work.iter().zip(out_dir.create_dirs(&dirs)?) {
-                files.extend(export::planned_files(&dir, &w.pattern, &w.options).all());
+        let with_dir: Vec<&DesignWork> = work
+            .iter()
+            .filter(|w| what(w.rank) != Written::None)
+            .collect();
+        let dirs: Vec<String> = with_dir
+            .iter()
+            .map(|w| format!("designs/{}", w.id))
+            .collect();
+        for (w, dir) in with_dir.into_iter().zip(out_dir.create_dirs(&dirs)?) {
+            let planned = export::planned_files(&dir, &w.pattern, &w.options);
+            match what(w.rank) {
+                Written::All => files.extend(planned.all()),
+                _ => files.push(planned.fold),
             }
         }
         out_dir.register(&files)?;
         let written = pool.install(|| {
             work.into_par_iter()
-                .map(|w| write_design(w, opts.export, out_dir, progress))
+                .map(|w| {
+                    let files = what(w.rank);
+                    let mut card = write_design(w, files, out_dir, progress)?;
+                    if files == Written::Fold {
+                        card.facts.push(files_on_demand(&card.id, out_dir, opts));
+                    }
+                    Ok::<_, SearchError>(card)
+                })
                 .collect::<Result<Vec<_>, _>>()
         })?;
         cards.extend(written);
@@ -87,9 +104,33 @@ pub(super) fn write_designs(
     Ok(cards)
 }
 
+/// Which of its files a design gets besides its JSON.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Written {
+    /// None (`--no-export`).
+    None,
+    /// Its FOLD file (a design outside `--export N`'s most robust).
+    Fold,
+    /// Every file (FOLD, SVG, meshes, pictures, GIF).
+    All,
+}
+
+/// The files of the design ranked `rank` (from 1, the most robust) with `opts`.
+fn files_of(opts: &SearchOptions, rank: usize) -> Written {
+    if !opts.export {
+        Written::None
+    } else if opts.export_top.is_none_or(|n| rank <= n) {
+        Written::All
+    } else {
+        Written::Fold
+    }
+}
+
 /// One design, built and ready to write.
 struct DesignWork {
     id: String,
+    /// 1: the most robust.
+    rank: usize,
     rec: AlternativeRecord,
     threshold: f64,
     /// `designs/<id>.json`.
@@ -158,16 +199,44 @@ fn build_design(
             ..Default::default()
         },
         id,
+        rank,
         pattern,
         meta,
     })
 }
 
-/// Write a design's `designs/<id>.json` and, with `export`, its files (the FOLD file
-/// verified); its card for the report.
+/// The report's line for a design outside `--export N`'s most robust (only its FOLD file
+/// written): the command that writes the rest.
+fn files_on_demand(id: &str, out_dir: &OutputDir, opts: &SearchOptions) -> Fact {
+    let n = opts.export_top.unwrap_or_default();
+    Fact::new(
+        "files",
+        format!(
+            "the FOLD file; the SVG, meshes, pictures and animation are written for the {n} most robust designs (--export {n}); this one's: foldsynth export {} --format all --out {}",
+            shell_word(&out_dir.path(&format!("designs/{id}.json"))),
+            shell_word(&out_dir.path(&format!("designs/{id}"))),
+        ),
+    )
+}
+
+/// `path` as one word of a POSIX shell command (quoted when it needs to be).
+fn shell_word(path: &Path) -> String {
+    let s = path.display().to_string();
+    let plain = s
+        .chars()
+        .all(|c| c.is_ascii_alphanumeric() || "-_./+=:,@".contains(c));
+    if plain && !s.is_empty() {
+        s
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// Write a design's `designs/<id>.json` and its `files` (the FOLD file verified); its
+/// card for the report.
 fn write_design(
     w: DesignWork,
-    export: bool,
+    files: Written,
     out_dir: &OutputDir,
     progress: &Progress,
 ) -> Result<ReportDesign, SearchError> {
@@ -177,26 +246,41 @@ fn write_design(
         path: path.display().to_string(),
         source,
     })?;
-    if !export {
-        progress.inc(1);
-        return Ok(report_design(
-            &w.rec,
-            w.threshold,
-            w.pattern,
-            w.meta,
-            path,
-            None,
-            None,
-        ));
-    }
+    let err = |e: export::ExportError| SearchError::Export(e.to_string());
     let out = out_dir.path(&format!("designs/{id}"));
-    let files = export::write_all(&out, &w.pattern, &w.meta, &w.options)
-        .map_err(|e| SearchError::Export(e.to_string()))?;
-    let check = export::verify::verify_file(&files.fold, &Default::default())
-        .map_err(|e| SearchError::Export(e.to_string()))?;
-    if !check.ok {
-        eprintln!("BUG: the exported FOLD file of {id} fails verification");
-    }
+    let written = match files {
+        Written::None => None,
+        Written::All => {
+            Some(export::write_all(&out, &w.pattern, &w.meta, &w.options).map_err(err)?)
+        }
+        Written::Fold => {
+            // The FOLD file alone, as `write_all` writes it; the other paths stay empty
+            // (the report links only what exists).
+            let fold = export::planned_files(&out, &w.pattern, &w.options).fold;
+            let meta = export::with_meshes(&w.meta).map_err(err)?;
+            let text = export::fold::to_fold_string(&w.pattern, &meta, w.options.fold_spec)
+                .map_err(err)?;
+            std::fs::write(&fold, text).map_err(|source| SearchError::Io {
+                path: fold.display().to_string(),
+                source,
+            })?;
+            Some(export::Files {
+                fold,
+                ..Default::default()
+            })
+        }
+    };
+    let check = match &written {
+        Some(f) => {
+            let check = export::verify::verify_file(&f.fold, &Default::default())
+                .map_err(|e| SearchError::Export(e.to_string()))?;
+            if !check.ok {
+                eprintln!("BUG: the exported FOLD file of {id} fails verification");
+            }
+            Some(check)
+        }
+        None => None,
+    };
     progress.inc(1);
     Ok(report_design(
         &w.rec,
@@ -204,8 +288,8 @@ fn write_design(
         w.pattern,
         w.meta,
         path,
-        Some(files),
-        Some(check),
+        written,
+        check,
     ))
 }
 

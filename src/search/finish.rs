@@ -1,9 +1,11 @@
 //! The end of a search (or of a merge): the records read back into the summary and the
-//! ranking, then the designs and the report written, and `summary.json` last.
+//! ranking, `alternatives.parquet`, then the designs and the report written, and
+//! `summary.json` last.
 
 use super::designs::write_designs;
 use super::options::{Evaluation, SearchError, SearchOptions};
 use super::output::{OutputDir, RECORDS};
+use super::parquet::write_results;
 use super::plan::Plan;
 use super::progress::Progress;
 use super::readback::{read_at, tally_records};
@@ -28,6 +30,8 @@ pub fn finish(
 ) -> Result<Summary, SearchError> {
     let records = out.path(RECORDS);
     let (tally, designs) = tally_records(plan, &records)?;
+    // The columnar copy of the records, complete before anything else is written.
+    write_results(out)?;
     let mut timings = Timings {
         enumerate_s: plan.enumerate_s,
         compile_s: ev.compile_s,

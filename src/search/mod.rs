@@ -12,7 +12,8 @@
 //! made by reading that file back line by line. Nothing is kept per alternative but one
 //! bit, so memory does not grow with N_max. [`output`] decides where a run may write,
 //! what it may delete (only what an earlier run listed in its manifest) and when its
-//! records may be reused. A run can be one shard of the search ([`run_shard`]; see
+//! records may be reused, and locks the directory ([`lock`]: one run at a time); at the
+//! end [`mod@parquet`] writes the records again as `alternatives.parquet`. A run can be one shard of the search ([`run_shard`]; see
 //! `distribute`).
 //!
 //! Each phase has its own file, in the order a run takes them: `options` (what they all
@@ -25,10 +26,12 @@
 mod designs;
 mod evaluate;
 mod finish;
+pub mod lock;
 mod measure;
 mod open;
 mod options;
 pub mod output;
+pub mod parquet;
 pub mod plan;
 mod progress;
 mod readback;
@@ -42,8 +45,8 @@ pub use evaluate::prepare;
 pub use finish::finish;
 pub use open::{open_output, settings};
 pub use options::{
-    Alternative, Evaluation, FailedModel, SHARD_REPORT, SHARD_TASK, SearchError, SearchOptions,
-    ShardReport, Share, check_search,
+    Alternative, EXPORT_TOP, Evaluation, ExportCount, FailedModel, SHARD_REPORT, SHARD_TASK,
+    SearchError, SearchOptions, ShardReport, Share, check_search,
 };
 pub use plan::{Plan, plan};
 pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};

@@ -33,9 +33,12 @@ pub struct SearchOptions {
     pub n_max: Option<usize>,
     /// States of the verification sweep over [0, t_max].
     pub sweep: usize,
-    /// Write FOLD/SVG/OBJ/STL/pictures/GIF for every feasible design (the design JSONs and
-    /// the report are written either way).
+    /// Write FOLD/SVG/OBJ/STL/pictures/GIF for feasible designs (the design JSONs and the
+    /// report are written either way); how many: [`SearchOptions::export_top`].
     pub export: bool,
+    /// With `export`, the files of only the this many most robust designs (the report's
+    /// ranking); `None`: of every design. The report gives the others' command.
+    pub export_top: Option<usize>,
     /// Show progress on stderr: a bar on a terminal, a status line every few seconds
     /// otherwise (see [`Progress`](super::Progress)).
     pub progress: bool,
@@ -58,10 +61,42 @@ impl Default for SearchOptions {
             n_max: None,
             sweep: 181,
             export: true,
+            export_top: Some(EXPORT_TOP),
             progress: true,
             rules: Rules::default(),
             post_check_only: false,
         }
+    }
+}
+
+/// How many of the most robust designs a run exports by default (`--export N`).
+pub const EXPORT_TOP: usize = 20;
+
+/// `--export N|all`: the files of the N most robust designs, or of all.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExportCount(pub Option<usize>);
+
+impl std::fmt::Display for ExportCount {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(n) => write!(f, "{n}"),
+            None => write!(f, "all"),
+        }
+    }
+}
+
+impl std::str::FromStr for ExportCount {
+    type Err = String;
+    fn from_str(s: &str) -> Result<ExportCount, String> {
+        if s.trim().eq_ignore_ascii_case("all") {
+            return Ok(ExportCount(None));
+        }
+        s.trim().parse::<usize>().map(|n| ExportCount(Some(n))).map_err(|_| {
+            format!(
+                "'{}' is neither a number of designs nor 'all' (e.g. --export 50, --export all; --no-export for none)",
+                crate::text::excerpt(s, 40)
+            )
+        })
     }
 }
 

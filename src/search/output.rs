@@ -1,6 +1,8 @@
 //! The output directory of a search: where a run may write, what it may delete, and when
 //! it may reuse earlier records.
 //!
+//! - One run at a time: a run locks its directory ([`super::lock`]) before it reads or
+//!   writes anything there; a second run is refused ([`OutputError::Busy`]) at once.
 //! - A run writes only under its output directory (`--out`, or `out/<name>` with the task
 //!   name made a safe file name by [`default_dir`]).
 //! - Every file and directory a run creates is listed in `OUT/manifest.json` *before* it
@@ -22,6 +24,7 @@ use std::sync::Mutex;
 
 use serde::{Deserialize, Serialize};
 
+use super::lock::{DirLock, LOCK, LockError, lock_dir};
 use super::record::AlternativeRecord;
 
 /// The list of files a run wrote.
@@ -186,6 +189,17 @@ pub enum OutputError {
         #[source]
         source: std::io::Error,
     },
+    /// Another run (process `pid`, when it has written its id) holds the directory's lock.
+    #[error(
+        "{path}: another foldsynth run ({}) is writing into this directory; wait for it to end, or give another --out (--resume and --force do not wait either)",
+        pid.map_or("a process that has not yet written its id to .foldsynth.lock".to_string(), |p| format!("process {p}"))
+    )]
+    Busy {
+        /// The directory.
+        path: String,
+        /// The process that holds the lock.
+        pid: Option<u32>,
+    },
     /// The directory is not one this run may use (without `--force`).
     #[error("{path}: {message}")]
     Refused {
@@ -298,6 +312,8 @@ fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Found<T> {
 pub struct OutputDir {
     root: PathBuf,
     manifest: Mutex<Manifest>,
+    /// This run's lock on the directory ([`super::lock`]), released when dropped.
+    _lock: DirLock,
 }
 
 /// The outcome of [`OutputDir::open`].
@@ -323,10 +339,11 @@ impl OutputDir {
         match fs::metadata(root) {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 fs::create_dir_all(root).map_err(io_err(root))?;
+                let lock = OutputDir::lock(root, &mut notes)?;
                 if resume {
                     notes.push(format!("--resume: {shown} did not exist; starting afresh"));
                 }
-                let dir = OutputDir::fresh(root)?;
+                let dir = OutputDir::fresh(root, lock)?;
                 return Ok(Opened {
                     dir,
                     resume: false,
@@ -342,7 +359,31 @@ impl OutputDir {
             }
             Ok(_) => {}
         }
-        let empty = fs::read_dir(root).map_err(io_err(root))?.next().is_none();
+        // Nothing in the directory is read before the lock is ours.
+        let lock = OutputDir::lock(root, &mut notes)?;
+        let created = lock.created;
+        let opened = OutputDir::open_existing(root, lock, settings, resume, force, notes);
+        if created && matches!(opened, Err(OutputError::Refused { .. })) {
+            // A refused directory is left as it was (the lock is released by now).
+            let _ = fs::remove_file(root.join(LOCK));
+        }
+        opened
+    }
+
+    /// Open `root`, an existing directory this run holds the `lock` of: see the module
+    /// docs for what is refused.
+    fn open_existing(
+        root: &Path,
+        lock: DirLock,
+        settings: &RunSettings,
+        resume: bool,
+        force: bool,
+        mut notes: Vec<String>,
+    ) -> Result<Opened, OutputError> {
+        let shown = root.display().to_string();
+        let empty = fs::read_dir(root)
+            .map_err(io_err(root))?
+            .all(|e| e.is_ok_and(|e| e.file_name() == LOCK));
         if empty {
             if resume {
                 notes.push(format!(
@@ -350,7 +391,7 @@ impl OutputDir {
                 ));
             }
             return Ok(Opened {
-                dir: OutputDir::fresh(root)?,
+                dir: OutputDir::fresh(root, lock)?,
                 resume: false,
                 notes,
             });
@@ -359,16 +400,32 @@ impl OutputDir {
         let old_settings: Found<serde_json::Value> = read_json(&root.join(SETTINGS));
         let manifest = match manifest {
             Found::Read(m) if m.creator == "foldsynth" => m,
-            other => return OutputDir::open_foreign(root, &other, resume, force, notes),
+            other => return OutputDir::open_foreign(root, lock, &other, resume, force, notes),
         };
         let same = settings.same_as(&old_settings);
-        OutputDir::open_earlier(root, &manifest, same, resume, force, notes)
+        OutputDir::open_earlier(root, lock, &manifest, same, resume, force, notes)
+    }
+
+    /// Take the lock on `root` ([`super::lock`]): refused while another run holds it.
+    fn lock(root: &Path, notes: &mut Vec<String>) -> Result<DirLock, OutputError> {
+        match lock_dir(root) {
+            Ok((lock, note)) => {
+                notes.extend(note);
+                Ok(lock)
+            }
+            Err(LockError::Busy(pid)) => Err(OutputError::Busy {
+                path: root.display().to_string(),
+                pid,
+            }),
+            Err(LockError::Io(e)) => Err(io_err(&root.join(LOCK))(e)),
+        }
     }
 
     /// Open `root`, which is not empty and holds no foldsynth run (`manifest`: what was
     /// found instead of its manifest): only with `force`, deleting nothing.
     fn open_foreign(
         root: &Path,
+        lock: DirLock,
         manifest: &Found<Manifest>,
         resume: bool,
         force: bool,
@@ -396,7 +453,7 @@ impl OutputDir {
             );
         }
         Ok(Opened {
-            dir: OutputDir::fresh(root)?,
+            dir: OutputDir::fresh(root, lock)?,
             resume: false,
             notes,
         })
@@ -408,6 +465,7 @@ impl OutputDir {
     /// with `force`.
     fn open_earlier(
         root: &Path,
+        lock: DirLock,
         manifest: &Manifest,
         same: Result<(), String>,
         resume: bool,
@@ -418,6 +476,7 @@ impl OutputDir {
         let dir = OutputDir {
             root: root.to_path_buf(),
             manifest: Mutex::new(Manifest::new()),
+            _lock: lock,
         };
         match same {
             Ok(()) => {
@@ -455,10 +514,11 @@ impl OutputDir {
         }
     }
 
-    fn fresh(root: &Path) -> Result<OutputDir, OutputError> {
+    fn fresh(root: &Path, lock: DirLock) -> Result<OutputDir, OutputError> {
         let dir = OutputDir {
             root: root.to_path_buf(),
             manifest: Mutex::new(Manifest::new()),
+            _lock: lock,
         };
         dir.save()?;
         Ok(dir)

@@ -51,6 +51,7 @@ pub fn run_shard(
     let ev = evaluate_units(task, plan, share.units, &out, resume, opts, &progress)?;
     drop(progress);
     let tally = tally_records(plan, &out.path(RECORDS))?.0;
+    super::parquet::write_results(&out)?;
     let report = ShardReport {
         shard: share.spec,
         units: share.units.len(),

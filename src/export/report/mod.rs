@@ -279,7 +279,11 @@ fn design_json(out_dir: &Path, d: &ReportDesign) -> Result<Value> {
             ("OBJ", &f.obj),
             ("STL", &f.stl),
         ] {
-            files.push((name.into(), rel(out_dir, p)?));
+            // An empty path: not written (a design outside `--export N` has its FOLD file
+            // only).
+            if !p.as_os_str().is_empty() {
+                files.push((name.into(), rel(out_dir, p)?));
+            }
         }
         if let Some(g) = &f.gif {
             files.push(("GIF".into(), rel(out_dir, g)?));
