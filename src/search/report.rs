@@ -90,10 +90,12 @@ fn task_facts(task: &Task, opts: &SearchOptions, s: &Summary) -> Vec<Fact> {
             opts.seed,
             s.settings["jobs"],
             opts.sweep,
-            if opts.export {
-                "every feasible design exported (FOLD, SVG, OBJ, STL, pictures, GIF)"
-            } else {
-                "--no-export: design JSONs only, no per-design files"
+            match (opts.export, opts.export_top) {
+                (false, _) => "--no-export: design JSONs only, no per-design files".to_string(),
+                (true, None) => "--export all: every design's files (FOLD, SVG, OBJ, STL, pictures, GIF)".to_string(),
+                (true, Some(n)) => format!(
+                    "every design's FOLD file; the SVG, OBJ, STL, pictures and GIF of the {n} most robust (--export {n}; a design's 'files' row gives the command for the others, --export all writes every one)"
+                ),
             }
         ),
     ));
