@@ -46,7 +46,9 @@ pub use options::{
     ShardReport, Share, check_search,
 };
 pub use plan::{Plan, plan};
-pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
+pub use progress::{
+    LINE_INTERVAL, Progress, ProgressEvent, ProgressHook, human_duration, status_line,
+};
 pub use readback::tally_records;
 pub use record::{AlternativeRecord, RankEntry, Summary, Tally, Timings, level_distribution};
 pub use run::{run, run_shard};
