@@ -15,7 +15,6 @@ use foldsynth::kinematics::{
 };
 use foldsynth::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use foldsynth::model::{Model as FsModel, Plan};
-use foldsynth::search::SearchOptions;
 use foldsynth::task::Task as FsTask;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -194,7 +193,11 @@ impl Task {
         sweep: usize,
         export: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let opts = SearchOptions {
+        // The thesis's rules (r1, r2); r2′ is `foldsynth.synthesize(rules="r1,r2,r2p")`.
+        let (rules, post_check_only) = ("r1,r2", false);
+        run::synthesize(
+            py,
+            self,
             out,
             jobs,
             starts,
@@ -204,11 +207,10 @@ impl Task {
             n_max,
             sweep,
             export,
-            progress: false,
-            // The thesis's rules (r1, r2); r2′ is the CLI's `--rules r1,r2,r2p`.
-            ..SearchOptions::default()
-        };
-        run::search(py, &self.task, opts, None)
+            rules,
+            post_check_only,
+            None,
+        )
     }
 
     fn __repr__(&self) -> String {
