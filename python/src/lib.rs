@@ -15,7 +15,6 @@ use foldsynth::kinematics::{
 };
 use foldsynth::model::compiled::{CompiledModel, ModelProblem, objective_target};
 use foldsynth::model::{Model as FsModel, Plan};
-use foldsynth::search::{self, SearchOptions};
 use foldsynth::task::Task as FsTask;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -23,6 +22,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use std::path::PathBuf;
 use std::sync::Arc;
+
+mod run;
 
 /// A NumPy vector handed to Python.
 type Vector<'py> = Bound<'py, PyArray1<f64>>;
@@ -142,8 +143,9 @@ impl Task {
             }
             g.graph.clone()
         } else if let Ok(s) = graph.cast::<PyString>() {
-            let s = s.to_str()?;
-            CreaseGraph::from_sequence(&self.task, s)
+            // `to_cow`: the stable ABI (abi3) before Python 3.10 has no borrowed UTF-8 view.
+            let s = s.to_cow()?;
+            CreaseGraph::from_sequence(&self.task, &s)
                 .map_err(|e| FoldsynthError::new_err(format!("graph '{s}': {e}")))?
         } else {
             return Err(PyTypeError::new_err(format!(
@@ -175,6 +177,7 @@ impl Task {
     /// export) into the directory `out`; returns the summary (as summary.json). `out`
     /// must be new, empty or a run of the same settings unless `force` (as the CLI's
     /// `--force`); every count is checked against its limit (as the CLI).
+    /// `foldsynth.synthesize` is the same search returning a `Run`, with progress.
     #[pyo3(signature = (out, *, jobs = 0, starts = 16, seed = 0, resume = false, force = false, n_max = None, sweep = 181, export = true))]
     #[allow(clippy::too_many_arguments)]
     fn synthesize<'py>(
@@ -190,13 +193,11 @@ impl Task {
         sweep: usize,
         export: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
-        if starts == 0 {
-            return Err(PyValueError::new_err("starts must be at least 1"));
-        }
-        if n_max == Some(0) {
-            return Err(PyValueError::new_err("n_max must be at least 1"));
-        }
-        let opts = SearchOptions {
+        // The thesis's rules (r1, r2); r2′ is `foldsynth.synthesize(rules="r1,r2,r2p")`.
+        let (rules, post_check_only) = ("r1,r2", false);
+        run::synthesize(
+            py,
+            self,
             out,
             jobs,
             starts,
@@ -206,20 +207,10 @@ impl Task {
             n_max,
             sweep,
             export,
-            progress: false,
-            // The thesis's rules (r1, r2); r2′ is the CLI's `--rules r1,r2,r2p`.
-            ..SearchOptions::default()
-        };
-        let task = &self.task;
-        let summary = py.detach(|| search::run(task, &opts)).map_err(fs_err)?;
-        if summary.verification_failures > 0 {
-            return Err(FoldsynthError::new_err(format!(
-                "{} designs failed verification (a bug; see the messages on stderr)",
-                summary.verification_failures
-            )));
-        }
-        let text = serde_json::to_string(&summary).map_err(fs_err)?;
-        py.import("json")?.call_method1("loads", (text,))
+            rules,
+            post_check_only,
+            None,
+        )
     }
 
     fn __repr__(&self) -> String {
@@ -321,7 +312,7 @@ impl Model {
             ))
         };
         let signs: Vec<f64> = if let Ok(s) = modes.cast::<PyString>() {
-            s.to_str()?
+            s.to_cow()?
                 .split(',')
                 .map(|m| {
                     Mode::parse(m)
@@ -675,15 +666,18 @@ fn vertex<'py>(py: Python<'py>, spec: &str, t: &Bound<'py, PyAny>) -> PyResult<B
     Ok(d)
 }
 
-/// foldsynth: synthesis of rigidly foldable origami crease patterns, with compiled design
-/// models evaluated on NumPy arrays.
+/// The native half of the `foldsynth` package (`foldsynth._native`): tasks, graphs,
+/// compiled models, the search and the design files; `foldsynth/__init__.py` re-exports
+/// them beside the pure-Python `Run`.
 #[pymodule]
-#[pyo3(name = "foldsynth")]
+#[pyo3(name = "_native")]
 fn foldsynth_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Task>()?;
     m.add_class::<Graph>()?;
     m.add_class::<Model>()?;
     m.add_function(wrap_pyfunction!(vertex, m)?)?;
+    m.add_function(wrap_pyfunction!(run::synthesize, m)?)?;
+    m.add_function(wrap_pyfunction!(run::design_fold, m)?)?;
     m.add("FoldsynthError", m.py().get_type::<FoldsynthError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -92,6 +92,7 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         progress: true,
         rules: args.rules,
         post_check_only: args.post_check_only,
+        on_progress: None,
     };
     if let Some(spec) = args.shard {
         // The text the task was read from, kept with the shard for the merge.

@@ -397,6 +397,7 @@ fn search_options(
         progress: false,
         rules,
         post_check_only: settings.post_check_only,
+        on_progress: None,
     })
 }
 

@@ -49,7 +49,9 @@ pub use options::{
     SearchError, SearchOptions, ShardReport, Share, check_search,
 };
 pub use plan::{Plan, plan};
-pub use progress::{LINE_INTERVAL, Progress, human_duration, status_line};
+pub use progress::{
+    LINE_INTERVAL, Progress, ProgressEvent, ProgressHook, human_duration, status_line,
+};
 pub use readback::tally_records;
 pub use record::{AlternativeRecord, RankEntry, Summary, Tally, Timings, level_distribution};
 pub use run::{run, run_shard};

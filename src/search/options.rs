@@ -3,6 +3,7 @@
 //! a task can be searched at all. It imports none of the phases.
 
 use super::output::{self, ShardSpec};
+use super::progress::ProgressHook;
 use super::record::Timings;
 use crate::grammar::Rules;
 use crate::limits;
@@ -47,6 +48,9 @@ pub struct SearchOptions {
     /// Today's behaviour before issue 12: optimize without the robustness block and only
     /// check afterwards (for side-by-side comparisons).
     pub post_check_only: bool,
+    /// Told of every step of the run's progress, and able to stop it (the Python
+    /// package's progress callback and Ctrl-C); `None` for the CLI.
+    pub on_progress: Option<ProgressHook>,
 }
 
 impl Default for SearchOptions {
@@ -65,6 +69,7 @@ impl Default for SearchOptions {
             progress: true,
             rules: Rules::default(),
             post_check_only: false,
+            on_progress: None,
         }
     }
 }
@@ -138,6 +143,15 @@ pub enum SearchError {
     /// Export failed.
     #[error("export: {0}")]
     Export(String),
+    /// The run was stopped through its [`ProgressHook`] before every alternative was
+    /// evaluated; the records written so far stay for `--resume`.
+    #[error(
+        "{out}: the search was interrupted; the records written so far are kept: run it again with resume (--resume) to continue"
+    )]
+    Interrupted {
+        /// The output directory.
+        out: String,
+    },
 }
 
 /// One design alternative: a graph, a gripping candidate and a mode assignment.

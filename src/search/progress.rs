@@ -22,14 +22,69 @@
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::{IsTerminal, Write};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{self, RecvTimeoutError, Sender};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 /// How often the plain (off-terminal) status line is written.
 pub const LINE_INTERVAL: Duration = Duration::from_secs(5);
+
+/// One step of a run's progress, as a [`ProgressHook`] is told it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProgressEvent<'a> {
+    /// The phase, e.g. `compile + optimize + check`.
+    pub phase: &'a str,
+    /// What it counts, e.g. `alternatives` (empty when it counts nothing).
+    pub unit: &'a str,
+    /// Items done so far in this phase.
+    pub done: u64,
+    /// Items in the phase, when known.
+    pub total: Option<u64>,
+    /// The phase has just ended (`done` is final).
+    pub finished: bool,
+}
+
+/// A function told of every step of a run's progress (a phase started, items done, a phase
+/// ended), called on whichever thread made the step, so it must be cheap and must not
+/// block; and a flag that stops the run (see [`ProgressHook::cancel`]). Library users (the
+/// Python package) watch a run through it without parsing stderr.
+#[derive(Clone)]
+pub struct ProgressHook {
+    callback: Arc<dyn Fn(&ProgressEvent<'_>) + Send + Sync>,
+    cancel: Arc<AtomicBool>,
+}
+
+impl ProgressHook {
+    /// A hook calling `callback` at every step.
+    pub fn new(callback: impl Fn(&ProgressEvent<'_>) + Send + Sync + 'static) -> ProgressHook {
+        ProgressHook {
+            callback: Arc::new(callback),
+            cancel: Arc::new(AtomicBool::new(false)),
+        }
+    }
+
+    /// Ask the run to stop: no alternative is started after this, and the search returns
+    /// [`SearchError::Interrupted`](super::SearchError::Interrupted) once those in
+    /// flight are written (so `--resume` continues from them).
+    pub fn cancel(&self) {
+        self.cancel.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether [`cancel`](Self::cancel) was called.
+    pub fn cancelled(&self) -> bool {
+        self.cancel.load(Ordering::Relaxed)
+    }
+}
+
+impl std::fmt::Debug for ProgressHook {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ProgressHook")
+            .field("cancelled", &self.cancelled())
+            .finish_non_exhaustive()
+    }
+}
 
 /// Where progress goes.
 enum Output {
@@ -53,9 +108,23 @@ struct Shared {
     out: Output,
     phase: Mutex<Option<Phase>>,
     done: AtomicU64,
+    hook: OnceLock<ProgressHook>,
 }
 
 impl Shared {
+    /// Tell the hook (if any) where phase `p` stands.
+    fn tell(&self, p: &Phase, done: u64, finished: bool) {
+        if let Some(h) = self.hook.get() {
+            (h.callback)(&ProgressEvent {
+                phase: &p.name,
+                unit: &p.unit,
+                done,
+                total: p.total,
+                finished,
+            });
+        }
+    }
+
     fn line(&self, text: &str) {
         match &self.out {
             Output::Bar(b) => b.println(text),
@@ -122,6 +191,7 @@ impl Progress {
             out,
             phase: Mutex::new(None),
             done: AtomicU64::new(0),
+            hook: OnceLock::new(),
         });
         let ticker = interval.map(|every| {
             let (stop, rx) = mpsc::channel::<()>();
@@ -138,17 +208,33 @@ impl Progress {
         Progress { shared, ticker }
     }
 
+    /// The same progress, also told to `hook` (when given) at every step.
+    pub fn with_hook(self, hook: Option<ProgressHook>) -> Progress {
+        if let Some(h) = hook {
+            // A new Progress has no hook yet: `set` cannot fail here.
+            let _ = self.shared.hook.set(h);
+        }
+        self
+    }
+
+    /// Whether the hook asked the run to stop ([`ProgressHook::cancel`]).
+    pub fn cancelled(&self) -> bool {
+        self.shared.hook.get().is_some_and(ProgressHook::cancelled)
+    }
+
     /// Start a phase (ending the one before): `total` items of `unit`, or unknown.
     pub fn phase(&self, name: &str, unit: &str, total: Option<u64>) {
         self.finish_phase();
         self.shared.done.store(0, Ordering::Relaxed);
         if let Ok(mut p) = self.shared.phase.lock() {
-            *p = Some(Phase {
+            let phase = Phase {
                 name: name.to_string(),
                 unit: unit.to_string(),
                 total,
                 started: Instant::now(),
-            });
+            };
+            self.shared.tell(&phase, 0, false);
+            *p = Some(phase);
         }
         match &self.shared.out {
             Output::Bar(b) => {
@@ -189,9 +275,15 @@ impl Progress {
 
     /// Count `n` more items of the running phase done.
     pub fn inc(&self, n: u64) {
-        self.shared.done.fetch_add(n, Ordering::Relaxed);
+        let done = self.shared.done.fetch_add(n, Ordering::Relaxed) + n;
         if let Output::Bar(b) = &self.shared.out {
             b.inc(n);
+        }
+        if self.shared.hook.get().is_some()
+            && let Ok(p) = self.shared.phase.lock()
+            && let Some(p) = p.as_ref()
+        {
+            self.shared.tell(p, done, false);
         }
     }
 
@@ -211,6 +303,7 @@ impl Progress {
             return;
         };
         let done = self.shared.done.load(Ordering::Relaxed);
+        self.shared.tell(&p, done, true);
         let mut text = done_line(&p.name, &p.unit, done, p.total, p.started.elapsed());
         if !detail.is_empty() {
             text += &format!("; {detail}");
@@ -384,5 +477,40 @@ mod tests {
                 .starts_with("progress: write designs: 2/2 designs in "),
             "{text}"
         );
+    }
+
+    #[test]
+    fn a_hook_hears_every_step_and_can_stop_the_run() {
+        type Heard = (String, u64, Option<u64>, bool);
+        let heard: Arc<Mutex<Vec<Heard>>> = Arc::default();
+        let h = Arc::clone(&heard);
+        let hook = ProgressHook::new(move |e| {
+            h.lock()
+                .unwrap()
+                .push((e.phase.to_string(), e.done, e.total, e.finished));
+        });
+        let p = Progress::hidden().with_hook(Some(hook.clone()));
+        p.phase("optimize", "alternatives", Some(3));
+        p.inc(1);
+        p.inc(2);
+        assert!(!p.cancelled());
+        hook.cancel();
+        assert!(p.cancelled());
+        p.phase("write", "", None);
+        drop(p);
+        let s = |t: &str| t.to_string();
+        assert_eq!(
+            *heard.lock().unwrap(),
+            vec![
+                (s("optimize"), 0, Some(3), false),
+                (s("optimize"), 1, Some(3), false),
+                (s("optimize"), 3, Some(3), false),
+                (s("optimize"), 3, Some(3), true),
+                (s("write"), 0, None, false),
+                (s("write"), 0, None, true),
+            ]
+        );
+        // Without a hook nothing can cancel.
+        assert!(!Progress::hidden().cancelled());
     }
 }

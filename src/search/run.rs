@@ -20,7 +20,7 @@ use std::time::Instant;
 pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     let start = Instant::now();
     let n_max = check_search(task, opts)?;
-    let progress = Progress::new(opts.progress);
+    let progress = Progress::new(opts.progress).with_hook(opts.on_progress.clone());
     progress.phase("enumerate graphs", "graphs", None);
     let plan = plan(task, n_max, opts.rules)?;
     progress.inc(plan.graphs.len() as u64);
@@ -47,7 +47,7 @@ pub fn run_shard(
     let n_max = check_search(task, opts)?;
     let (out, resume) = open_output(&settings(task, n_max, opts, Some(share.spec)), opts)?;
     out.write(SHARD_TASK, share.task_text)?;
-    let progress = Progress::new(opts.progress);
+    let progress = Progress::new(opts.progress).with_hook(opts.on_progress.clone());
     let ev = evaluate_units(task, plan, share.units, &out, resume, opts, &progress)?;
     drop(progress);
     let tally = tally_records(plan, &out.path(RECORDS))?.0;

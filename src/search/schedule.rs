@@ -80,6 +80,11 @@ pub fn evaluate_units(
         });
     });
     progress.finish_phase();
+    if progress.cancelled() {
+        return Err(SearchError::Interrupted {
+            out: out.root().display().to_string(),
+        });
+    }
     if let Some(e) = work.write_error.into_inner().ok().flatten() {
         // A record that is not on disk would be lost to --resume: stop here.
         return Err(SearchError::Io {
@@ -161,6 +166,9 @@ impl Work<'_> {
     /// Compile unit `u`'s model, evaluate its alternatives `modes` (their classes in
     /// parallel) and drop the model.
     fn unit(&self, u: usize, modes: &[u32]) {
+        if self.progress.cancelled() {
+            return;
+        }
         let (task, plan) = (self.task, self.plan);
         let unit = &plan.units[u];
         let graph = plan.graph(task, unit.graph);
@@ -211,6 +219,9 @@ impl Work<'_> {
         let key = self.plan.alternative(u, canonical).key();
         let shared = SharedStarts::new(alternative_seed(self.opts.seed, &key));
         for &m in members {
+            if self.progress.cancelled() {
+                return;
+            }
             let alt = self.plan.alternative(u, m);
             match evaluate(self.task, prepared, &alt, graph, self.opts, &shared) {
                 Ok(rec) => self.write(&rec),
