@@ -162,7 +162,7 @@ fn fields_no_column_holds_come_back_whole() {
     // i64 holds, and modes a joined text could not give back.
     first["future"] = json!({"a": [1, 2.5, "x"]});
     first["verification"]["new_measure"] = json!(3);
-    first["graph"] = json!(u64::MAX);
+    first["graph"] = json!(1u64 << 63);
     first["modes"] = json!(["up,down"]);
     let lines = format!("{first}\n{}\n", records[0]);
     let jsonl = tmp.path().join("edited.jsonl");

@@ -3,7 +3,7 @@
 //! (and by `merge`) from the JSONL, which stays the file a killed run streams into, so the
 //! two always hold the same records in the same order.
 //!
-//! The schema is [`COLUMNS`]: every scalar of a record a typed column, the nested parts
+//! The schema is [`columns`]: every scalar of a record a typed column, the nested parts
 //! whose shape is fixed (`verification`, each margin of `robustness`) flattened into
 //! columns, the parts whose shape varies from graph to graph or task to task
 //! (`variables`, `requirements`, `cycle`, the first intersection found, …) one JSON text
