@@ -635,3 +635,24 @@ fn what_cannot_be_built_is_refused_naming_the_crease() {
         }
     }
 }
+
+#[test]
+fn refined_ranges_find_a_peak_between_frames() {
+    // ρ(t) = 1.5 − (t − 0.3)² sampled at t = 0, 0.5, 1: the peak 1.5 at t = 0.3 is not a
+    // frame; the parabola through the three samples is ρ itself.
+    let ts = [0.0, 0.5, 1.0];
+    let rho = |t: f64| 1.5 - (t - 0.3) * (t - 0.3);
+    let mut p = two_facets(&ts.map(rho));
+    for (f, t) in p.frames.iter_mut().zip(ts) {
+        f.t = t;
+    }
+    let plain = fabricate::fold_ranges(&p, &p.frames);
+    let refined = fabricate::fold_ranges_refined(&p, &p.frames);
+    assert!((plain[0].valley - rho(0.5)).abs() < 1e-12);
+    assert!(
+        (refined[0].valley - 1.5).abs() < 1e-12,
+        "{}",
+        refined[0].valley
+    );
+    assert_eq!(refined[0].mountain, 0.0);
+}

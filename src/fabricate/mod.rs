@@ -252,11 +252,11 @@ pub fn fold_ranges_refined(pattern: &Pattern, frames: &[Frame]) -> Vec<FoldRange
         let d01 = (y1 - y0) / (t1 - t0);
         let d12 = (y2 - y1) / (t2 - t1);
         let d2 = (d12 - d01) / (t2 - t0);
-        if !(d2 < 0.0) {
+        if d2.is_nan() || d2 >= 0.0 {
             return y1;
         }
         let tp = 0.5 * (t0 + t1) - d01 / (2.0 * d2);
-        if !(tp > t0 && tp < t2) {
+        if tp.is_nan() || tp <= t0 || tp >= t2 {
             return y1;
         }
         let yp = y0 + d01 * (tp - t0) + d2 * (tp - t0) * (tp - t1);
@@ -266,7 +266,7 @@ pub fn fold_ranges_refined(pattern: &Pattern, frames: &[Frame]) -> Vec<FoldRange
         for (sign, slot) in [(1.0, &mut o.valley), (-1.0, &mut o.mountain)] {
             let best = (1..frames.len().saturating_sub(1))
                 .filter(|&i| frames[i - 1].t < frames[i].t && frames[i].t < frames[i + 1].t)
-                .filter(|&i| (sign * series[i][e] - *slot).abs() == 0.0 && *slot > 0.0)
+                .filter(|&i| *slot > 0.0 && sign * series[i][e] >= *slot)
                 .map(|i| peak(i, e, sign))
                 .fold(*slot, f64::max);
             *slot = best;
