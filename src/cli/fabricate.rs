@@ -15,7 +15,7 @@ use crate::task::fabrication::{
 /// Arguments of `foldsynth fabricate`.
 #[derive(Debug, clap::Args)]
 pub struct FabricateArgs {
-    /// Design JSON as `synthesize` writes it (OUT/designs/<id>.json).
+    /// Design JSON as `synthesize` writes it (`OUT/designs/<id>.json`).
     pub design: PathBuf,
     /// Panel thickness in mm.
     #[arg(long, allow_hyphen_values = true)]
@@ -138,7 +138,7 @@ pub fn run(a: FabricateArgs) -> anyhow::Result<()> {
     std::fs::write(&json, text + "\n").with_context(|| format!("{}", json.display()))?;
     files.push(json);
     println!(
-        "{} panels, {} hinges, {} mm thick ({} sides) at {} mm per unit; widest hinge gap {:.3} mm",
+        "{} panels, {} hinges, {} mm thick (sides = {}) at {} mm per unit; widest hinge gap {:.3} mm",
         design.panels.len(),
         design.hinges.len(),
         crate::text::num(spec.thickness),

@@ -213,9 +213,7 @@ fn strip_subclass_markers(dxf: &[u8]) -> Vec<u8> {
         }
     }
     // `split` gave a last empty piece after the final newline: do not double it.
-    if !text.ends_with('\n') {
-        out.pop();
-    } else if out.ends_with("\n\n") {
+    if !text.ends_with('\n') || out.ends_with("\n\n") {
         out.pop();
     }
     out.into_bytes()

@@ -14,7 +14,7 @@
 //! - [`mesh`]: OBJ and STL of a folded state,
 //! - [`plots`]: the search tree (thesis Fig. 48) and the distribution of designs (Fig. 51),
 //! - [`report`]: the self-contained, interactive `report.html` (three.js inlined),
-//! - [`laser`], [`print`]: a thick design's ply drawings (DXF, SVG) and solids (STL, 3MF),
+//! - [`laser`], [`print`](mod@print): a thick design's ply drawings (DXF, SVG) and solids (STL, 3MF),
 //! - [`samples`]: small patterns with exact rigid motions (tests and demos).
 //!
 //! ```
