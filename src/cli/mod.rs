@@ -9,6 +9,7 @@ pub mod bench_numeric;
 pub mod compile;
 pub mod enumerate;
 pub mod export;
+pub mod fabricate;
 pub mod formulas;
 pub mod fuzz;
 pub mod merge;
@@ -55,6 +56,8 @@ pub enum Command {
     Export(export::ExportArgs),
     /// Check a FOLD file: isometry of every folded frame, fold angles, face consistency.
     Verify(verify::VerifyArgs),
+    /// Thick panels for a design: ply drawings (DXF, SVG), panel solids (STL, 3MF), bill.
+    Fabricate(fabricate::FabricateArgs),
     /// Simulate a pattern file with the bar-and-hinge model (thesis Sec. 3).
     Simulate(simulate::SimulateArgs),
     /// Optimize the adapted flasher by simulated annealing (thesis Sec. 3.6-3.7).
@@ -111,6 +114,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compile(a) => compile::run(a),
         Command::Export(a) => export::run(a),
         Command::Verify(a) => verify::run(a),
+        Command::Fabricate(a) => fabricate::run(a),
         Command::Simulate(a) => simulate::run(a),
         Command::OptimizeFlasher(a) => optimize_flasher::run(a),
         Command::Fuzz(a) => fuzz::run(a),

@@ -14,6 +14,7 @@
 //! - [`mesh`]: OBJ and STL of a folded state,
 //! - [`plots`]: the search tree (thesis Fig. 48) and the distribution of designs (Fig. 51),
 //! - [`report`]: the self-contained, interactive `report.html` (three.js inlined),
+//! - [`laser`], [`print`](mod@print): a thick design's ply drawings (DXF, SVG) and solids (STL, 3MF),
 //! - [`samples`]: small patterns with exact rigid motions (tests and demos).
 //!
 //! ```
@@ -26,11 +27,13 @@
 //! ```
 
 pub mod fold;
+pub mod laser;
 pub mod lzw;
 pub mod mesh;
 pub mod meta_file;
 pub mod palette;
 pub mod plots;
+pub mod print;
 pub mod raster;
 pub mod render;
 pub mod report;

@@ -1,0 +1,309 @@
+//! `foldsynth fabricate` end to end (issue 32): the files it writes read back by
+//! independent readers (ezdxf for the DXF, trimesh for STL and 3MF, when Python has them;
+//! `FOLDSYNTH_REQUIRE_FAB_TOOLS=1` makes their absence a failure), the STL read back here
+//! by `stl_io` and judged closed, outward and equal to the rigid motion of the flat panels,
+//! and bad values refused with the flag named.
+
+use foldsynth::export::samples;
+use foldsynth::fabricate;
+use foldsynth::geom;
+use foldsynth::task::fabrication::{FabMethod, Fabrication, Sides};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_foldsynth"))
+}
+
+/// A design file of the sample with one crease (an L-shaped, non-convex facet on one side),
+/// folded to 2 rad in 9 frames.
+fn design(dir: &Path) -> (PathBuf, foldsynth::pattern::Pattern) {
+    let p = samples::single_crease(2.0, 9);
+    let path = dir.join("design.json");
+    let text = serde_json::json!({"pattern": p, "meta": {"task": "fab-test"}});
+    std::fs::write(&path, text.to_string()).unwrap();
+    (path, p)
+}
+
+fn run(args: &[&str]) -> std::process::Output {
+    bin().args(args).output().unwrap()
+}
+
+/// The STL's triangles with corners merged by exact value: closed (each directed edge once,
+/// its opposite once), positive volume.
+fn stl_closed_volume(path: &Path) -> f64 {
+    let mut f = std::fs::File::open(path).unwrap();
+    let mesh = stl_io::read_stl(&mut f).unwrap();
+    let mut directed = std::collections::HashMap::new();
+    let mut vol = 0.0;
+    for t in &mesh.faces {
+        let [a, b, c] = t.vertices;
+        for (x, y) in [(a, b), (b, c), (c, a)] {
+            *directed.entry((x, y)).or_insert(0) += 1;
+        }
+        let v = |i: usize| mesh.vertices[i].0.map(f64::from);
+        vol += geom::dot(v(a), geom::cross(v(b), v(c))) / 6.0;
+    }
+    for (&(x, y), &n) in &directed {
+        assert_eq!(n, 1, "{}: edge used {n} times", path.display());
+        assert_eq!(
+            directed.get(&(y, x)),
+            Some(&1),
+            "{}: open edge",
+            path.display()
+        );
+    }
+    vol
+}
+
+const READER: &str = r#"
+import json, sys, ezdxf, trimesh
+out, n_panels = sys.argv[1], int(sys.argv[2])
+bill = json.load(open(out + "/fabrication.json"))["fabrication"]
+res = {}
+for ply in ["rigid", "hinge"]:
+    doc = ezdxf.readfile(f"{out}/ply-{ply}.dxf")
+    layers = sorted(l.dxf.name for l in doc.layers)
+    msp = doc.modelspace()
+    cut = [[list(v.dxf.location)[:2] for v in e.vertices] for e in msp.query("POLYLINE[layer=='CUT']")]
+    res[ply] = {"version": doc.dxfversion, "layers": layers, "cut": cut,
+                "labels": [t.dxf.text for t in msp.query("TEXT")],
+                "lines": {l: len(msp.query(f"LINE[layer=='{l}']")) for l in ["CUT", "SCORE", "MOUNTAIN", "VALLEY"]}}
+import zipfile, xml.etree.ElementTree as ET
+def meshes_3mf(path):
+    # The model part is the one _rels/.rels names (OPC); trimesh only looks for
+    # 3D/3dmodel.model, so read the XML here and judge the meshes with trimesh.
+    z = zipfile.ZipFile(path)
+    rels = ET.fromstring(z.read("_rels/.rels"))
+    target = [r.get("Target") for r in rels if r.get("Type").endswith("/3dmodel")][0].lstrip("/")
+    root = ET.fromstring(z.read(target))
+    assert root.get("unit") == "millimeter"
+    ns = {"c": "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"}
+    out = []
+    for obj in root.iter("{%s}object" % ns["c"]):
+        v = [[float(x.get(a)) for a in "xyz"] for x in obj.iter("{%s}vertex" % ns["c"])]
+        f = [[int(x.get(a)) for a in ("v1", "v2", "v3")] for x in obj.iter("{%s}triangle" % ns["c"])]
+        out.append(trimesh.Trimesh(vertices=v, faces=f, process=True))
+    return out
+solids = {}
+for k in range(n_panels):
+    m = trimesh.load(f"{out}/panel-{k}.stl", force="mesh")
+    solids[f"panel-{k}.stl"] = [bool(m.is_watertight), bool(m.is_winding_consistent), float(m.volume)]
+    (m,) = meshes_3mf(f"{out}/panel-{k}.3mf")
+    solids[f"panel-{k}.3mf"] = [bool(m.is_watertight), bool(m.is_winding_consistent), float(m.volume)]
+for st in ["flat", "folded"]:
+    solids[f"assembly-{st}.3mf"] = [[bool(g.is_watertight), float(g.volume)] for g in meshes_3mf(f"{out}/assembly-{st}.3mf")]
+res["solids"] = solids
+print(json.dumps(res))
+"#;
+
+/// Python with ezdxf and trimesh: the repository's .venv first, then python3.
+fn python() -> Option<PathBuf> {
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
+    [venv, PathBuf::from("python3")].into_iter().find(|py| {
+        Command::new(py)
+            .args(["-c", "import ezdxf, trimesh, networkx, lxml"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    })
+}
+
+#[test]
+fn written_files_read_back_as_built() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, pattern) = design(dir.path());
+    let out = dir.path().join("fab");
+    let o = run(&[
+        "fabricate",
+        path.to_str().unwrap(),
+        "--thickness",
+        "4",
+        "--scale",
+        "50",
+        "--hinge-gap",
+        "0.4",
+        "--states",
+        "flat,half,folded",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The same build here, for what the files must hold.
+    let spec = Fabrication {
+        thickness: 4.0,
+        scale: 50.0,
+        method: FabMethod::Tapered,
+        sides: Sides::One,
+        hinge_gap: 0.4,
+        min_width: 2.0,
+    };
+    let ranges = fabricate::fold_ranges_refined(&pattern, &pattern.frames);
+    let thick = fabricate::build(&pattern, &ranges, &spec).unwrap();
+    // Every panel closed with its volume; the assembly at the last frame is the rigid motion
+    // of the flat panels (STL holds f32: compare to 1e-4 mm).
+    for (k, s) in thick.flat_solids().iter().enumerate() {
+        let v = stl_closed_volume(&out.join(format!("panel-{k}.stl")));
+        let want: f64 = s
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| geom::scale(s.vertices[i], 50.0));
+                geom::dot(a, geom::cross(b, c)) / 6.0
+            })
+            .sum();
+        assert!(
+            want > 0.0 && (v - want).abs() < 1e-4 * want,
+            "{v} vs {want}"
+        );
+    }
+    let last = pattern.frames.last().unwrap();
+    let mut f = std::fs::File::open(out.join("assembly-folded.stl")).unwrap();
+    let mesh = stl_io::read_stl(&mut f).unwrap();
+    let moved = thick.solids_at(&pattern, last);
+    let mut i = 0;
+    for s in &moved {
+        for t in &s.triangles {
+            let face = &mesh.faces[i];
+            for (k, &vi) in t.iter().enumerate() {
+                let got = mesh.vertices[face.vertices[k]].0.map(f64::from);
+                let want = geom::scale(s.vertices[vi], 50.0);
+                assert!(geom::dist(got, want) < 1e-4, "{got:?} vs {want:?}");
+            }
+            i += 1;
+        }
+    }
+    assert_eq!(i, mesh.faces.len());
+    assert!(stl_closed_volume(&out.join("assembly-folded.stl")) > 0.0);
+    let bill: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fabrication.json")).unwrap())
+            .unwrap();
+    let crease = &bill["fabrication"]["creases"][0];
+    // The bill's fold is the motion's: the sample folds its crease to 2 rad.
+    assert!((crease["valley_deg"].as_f64().unwrap() - 2f64.to_degrees()).abs() < 1e-9);
+    assert!((crease["hinge_length_mm"].as_f64().unwrap() - 50.0).abs() < 1e-9);
+    let gap = 0.4 + 2.0 * 4.0 * 1f64.tan();
+    assert!((crease["gap_mm"].as_f64().unwrap() - gap).abs() < 1e-9);
+    independent_readers(&out, &thick);
+}
+
+fn independent_readers(out: &Path, thick: &fabricate::ThickDesign) {
+    let Some(py) = python() else {
+        let msg = "python with ezdxf, trimesh, networkx and lxml not found: DXF/STL/3MF not read back independently";
+        assert!(
+            std::env::var("FOLDSYNTH_REQUIRE_FAB_TOOLS").as_deref() != Ok("1"),
+            "{msg} (FOLDSYNTH_REQUIRE_FAB_TOOLS=1)"
+        );
+        eprintln!("skipped: {msg}");
+        return;
+    };
+    let o = Command::new(py)
+        .args([
+            "-c",
+            READER,
+            out.to_str().unwrap(),
+            &thick.panels.len().to_string(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for ply in ["rigid", "hinge"] {
+        assert_eq!(r[ply]["version"], "AC1009", "{ply}: DXF R12");
+        for l in ["CUT", "SCORE", "MOUNTAIN", "VALLEY", "LABEL"] {
+            assert!(
+                r[ply]["layers"].as_array().unwrap().iter().any(|x| x == l),
+                "{ply}: no layer {l}"
+            );
+        }
+    }
+    // The rigid ply's cut outlines are the panels' top layers, in mm, as written.
+    let cut = r["rigid"]["cut"].as_array().unwrap();
+    assert_eq!(cut.len(), thick.panels.len());
+    for (panel, poly) in thick.panels.iter().zip(cut) {
+        let top = &panel.layers.last().unwrap().outline;
+        let pts = poly.as_array().unwrap();
+        assert_eq!(pts.len(), top.len());
+        for (p, q) in top.iter().zip(pts) {
+            for k in 0..2 {
+                assert!((p[k] * 50.0 - q[k].as_f64().unwrap()).abs() < 1e-9);
+            }
+        }
+    }
+    let labels = r["rigid"]["labels"].as_array().unwrap();
+    assert_eq!(labels.len(), thick.panels.len());
+    assert_eq!(r["rigid"]["lines"]["SCORE"], thick.hinges.len());
+    assert_eq!(r["hinge"]["lines"]["VALLEY"], 1);
+    for (name, v) in r["solids"].as_object().unwrap() {
+        if name.starts_with("panel-") {
+            assert_eq!(v[0], true, "{name}: not watertight");
+            assert_eq!(v[1], true, "{name}: winding");
+            assert!(v[2].as_f64().unwrap() > 0.0, "{name}: volume");
+        } else {
+            let parts = v.as_array().unwrap();
+            assert_eq!(parts.len(), thick.panels.len(), "{name}");
+            for p in parts {
+                assert!(p[0] == true && p[1].as_f64().unwrap() > 0.0, "{name}: {p}");
+            }
+        }
+    }
+}
+
+#[test]
+fn bad_values_are_refused_naming_the_flag_or_the_crease() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, _) = design(dir.path());
+    let out = dir.path().join("fab");
+    let base = |extra: &[&str]| {
+        let mut a = vec![
+            "fabricate",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        run(&a)
+    };
+    for (args, flag) in [
+        (vec!["--thickness", "0", "--scale", "10"], "--thickness"),
+        (vec!["--thickness", "-1", "--scale", "10"], "--thickness"),
+        (vec!["--thickness", "nan", "--scale", "10"], "--thickness"),
+        (vec!["--thickness", "inf", "--scale", "10"], "--thickness"),
+        (vec!["--thickness", "1", "--scale", "0"], "--scale"),
+        (
+            vec!["--thickness", "1", "--scale", "10", "--method", "folded"],
+            "--method",
+        ),
+        (
+            vec!["--thickness", "1", "--scale", "10", "--sides", "three"],
+            "--sides",
+        ),
+        (
+            vec!["--thickness", "1", "--scale", "10", "--hinge-gap", "-1"],
+            "--hinge-gap",
+        ),
+        (
+            vec![
+                "--thickness",
+                "1",
+                "--scale",
+                "10",
+                "--states",
+                "flat,upside",
+            ],
+            "--states",
+        ),
+    ] {
+        let o = base(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(flag), "{args:?}: {err}");
+    }
+    // Thickness that leaves no panel: named crease and file.
+    let o = base(&["--thickness", "400", "--scale", "100"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("crease 0") && err.contains("design.json"),
+        "{err}"
+    );
+}
