@@ -258,6 +258,101 @@ pub fn fit_plane(points: &[V3]) -> Option<(V3, V3)> {
     normalize([v[0], v[1], v[2]]).map(|nrm| (c, nrm))
 }
 
+/// 2D cross product (z component of (a, 0) × (b, 0)).
+pub fn cross_2d(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[1] - a[1] * b[0]
+}
+
+/// Whether the closed segments `p0 p1` and `q0 q1` share a point (touching counts).
+pub fn segments_meet_2d(p0: [f64; 2], p1: [f64; 2], q0: [f64; 2], q1: [f64; 2]) -> bool {
+    let d = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
+        cross_2d([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]])
+    };
+    let on = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
+        c[0] >= a[0].min(b[0])
+            && c[0] <= a[0].max(b[0])
+            && c[1] >= a[1].min(b[1])
+            && c[1] <= a[1].max(b[1])
+    };
+    let (d1, d2) = (d(q0, q1, p0), d(q0, q1, p1));
+    let (d3, d4) = (d(p0, p1, q0), d(p0, p1, q1));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    (d1 == 0.0 && on(q0, q1, p0))
+        || (d2 == 0.0 && on(q0, q1, p1))
+        || (d3 == 0.0 && on(p0, p1, q0))
+        || (d4 == 0.0 && on(p0, p1, q1))
+}
+
+/// Whether a closed polygon is simple: no two non-adjacent sides meet.
+pub fn polygon_is_simple_2d(pts: &[[f64; 2]]) -> bool {
+    let n = pts.len();
+    for i in 0..n {
+        for j in i + 1..n {
+            let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+            if !adjacent && segments_meet_2d(pts[i], pts[(i + 1) % n], pts[j], pts[(j + 1) % n]) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Triangles of a simple counter-clockwise polygon by ear clipping, as index triples into
+/// `pts`, each counter-clockwise; `None` when no ear is found (not simple or not ccw).
+/// Collinear corners are clipped as flat ears, so every side of the polygon is a side of
+/// exactly one triangle (what a closed mesh needs).
+pub fn triangulate_2d(pts: &[[f64; 2]]) -> Option<Vec<[usize; 3]>> {
+    let mut idx: Vec<usize> = (0..pts.len()).collect();
+    let mut out = Vec::with_capacity(pts.len().saturating_sub(2));
+    let sub2 = |a: [f64; 2], b: [f64; 2]| [a[0] - b[0], a[1] - b[1]];
+    while idx.len() > 3 {
+        let m = idx.len();
+        let ear = (0..m).find(|&k| {
+            let (a, b, c) = (idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m]);
+            let turn = cross_2d(sub2(pts[b], pts[a]), sub2(pts[c], pts[b]));
+            turn >= 0.0
+                && idx.iter().all(|&q| {
+                    q == a || q == b || q == c || {
+                        let p = pts[q];
+                        let s1 = cross_2d(sub2(pts[b], pts[a]), sub2(p, pts[a]));
+                        let s2 = cross_2d(sub2(pts[c], pts[b]), sub2(p, pts[b]));
+                        let s3 = cross_2d(sub2(pts[a], pts[c]), sub2(p, pts[c]));
+                        // Strictly outside, or on the ear's new diagonal's far side.
+                        s1 < 0.0 || s2 < 0.0 || s3 < 0.0 || turn == 0.0
+                    }
+                })
+        })?;
+        let (a, b, c) = (idx[(ear + m - 1) % m], idx[ear], idx[(ear + 1) % m]);
+        out.push([a, b, c]);
+        idx.remove(ear);
+    }
+    if idx.len() == 3 {
+        out.push([idx[0], idx[1], idx[2]]);
+    }
+    Some(out)
+}
+
+/// The point where the lines `p + s·u` and `q + r·w` cross, or `None` when they are
+/// parallel (|u × w| ≤ 1e-12·|u||w|).
+pub fn line_intersection_2d(
+    p: [f64; 2],
+    u: [f64; 2],
+    q: [f64; 2],
+    w: [f64; 2],
+) -> Option<[f64; 2]> {
+    let den = cross_2d(u, w);
+    let size = (u[0].hypot(u[1])) * (w[0].hypot(w[1]));
+    if den.abs() <= 1e-12 * size || !den.is_finite() {
+        return None;
+    }
+    let s = cross_2d([q[0] - p[0], q[1] - p[1]], w) / den;
+    Some([p[0] + s * u[0], p[1] + s * u[1]])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -16,6 +16,7 @@ pub mod cpu_time;
 pub mod distribute;
 pub mod export;
 pub mod expr;
+pub mod fabricate;
 pub mod fuzz;
 pub mod geom;
 pub mod grammar;
