@@ -5,7 +5,11 @@
 //!   facets apart (their plane keeps `clearance/2 + reach` each side), `reach·|x − apex|`
 //!   for facets meeting at a point, `reach` on an obstacle's side, none on the margins; every
 //!   crease bounded by the tapered setback limit `2 atan(MAX_SETBACK / reach)`;
-//! - that limit is where `reach · tan(ρ/2)` equals `MAX_SETBACK`.
+//! - that limit is where `reach · tan(ρ/2)` equals `MAX_SETBACK`;
+//! - a real run of `grammar/gripper_thick.toml` (N_max = 2): every design's thick panels,
+//!   tested as triangle meshes on the dense sweep by `check::thick`, keep the clearance from
+//!   each other, the other arm and the cylinder, every design JSON carries the bill, and every
+//!   alternative that passes the other checks but not this one says why.
 
 use foldsynth::grammar::{Enumeration, Filters};
 use foldsynth::model::Model;
@@ -15,6 +19,10 @@ use foldsynth::model::robust::{
 };
 use foldsynth::task::Task;
 use std::collections::HashMap;
+
+#[path = "common/runs.rs"]
+#[allow(dead_code)] // only the runner is used here
+mod runs;
 
 const GRIPPER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper.toml");
 
@@ -173,4 +181,95 @@ fn the_fold_limit_is_where_the_setback_reaches_its_bound() {
         "{}",
         rho.to_degrees()
     );
+}
+
+#[test]
+fn a_thick_gripper_run_keeps_every_panel_clear_on_the_dense_sweep() {
+    use foldsynth::search::AlternativeRecord;
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper_thick.toml");
+    let task = Task::load(file).unwrap();
+    let fab = task.fabrication.unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    runs::foldsynth_ok(&[
+        "synthesize",
+        file,
+        "--n-max",
+        "2",
+        "--no-export",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let records: Vec<AlternativeRecord> = std::fs::read_to_string(out.join("alternatives.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let designs: Vec<&AlternativeRecord> = records.iter().filter(|r| r.feasible_design()).collect();
+    assert!(!designs.is_empty(), "no design kept");
+    for r in &designs {
+        let f = r
+            .fabrication
+            .as_ref()
+            .expect("a design of a thick task is built");
+        assert!(f.refused.is_none(), "{}", r.key);
+        let c = f.check.as_ref().unwrap();
+        assert!(c.passes(), "{}: {:?}", r.key, f.failure());
+        assert!(c.states >= 181 && c.pairs > 0, "{}", r.key);
+        assert!(c.least_apart >= task.robustness.clearance, "{}", r.key);
+        assert!(
+            c.least_obstacle >= task.robustness.obstacle_clearance,
+            "{}",
+            r.key
+        );
+    }
+    // Every alternative that passes the other checks and is not a design because of its
+    // thick panels says why.
+    for r in records
+        .iter()
+        .filter(|r| r.fabrication.as_ref().is_some_and(|f| !f.passes()))
+    {
+        assert!(!r.feasible_design());
+        assert!(
+            r.fabrication.as_ref().unwrap().failure().is_some(),
+            "{}",
+            r.key
+        );
+    }
+    // The design JSONs: the bill of the build and the hinge axes.
+    let limit = thick_fold_limit(&fab).to_degrees();
+    let mut jsons = 0;
+    for e in std::fs::read_dir(out.join("designs")).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_none_or(|x| x != "json") {
+            continue;
+        }
+        jsons += 1;
+        let d: serde_json::Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+        let bill = &d["fabrication"]["bill"];
+        assert_eq!(bill["thickness_mm"], 2.0);
+        let faces = d["pattern"]["faces"].as_array().unwrap().len();
+        // Both arms are built: the pattern of the JSON is the arm.
+        assert_eq!(
+            bill["panels"].as_array().unwrap().len(),
+            2 * faces,
+            "{}",
+            p.display()
+        );
+        for c in bill["creases"].as_array().unwrap() {
+            let deg = c["largest_fold_deg"].as_f64().unwrap();
+            // Driven creases fold to t_max = 90°; the others stay within the setback bound
+            // (with the optimizer's 0.5 % acceptance safety).
+            assert!(deg <= limit + 1e-6, "{}: {c}", p.display());
+            let [a, b] = [0, 1].map(|k| c["axis_mm"][k].as_array().unwrap().clone());
+            let len = (a[0].as_f64().unwrap() - b[0].as_f64().unwrap())
+                .hypot(a[1].as_f64().unwrap() - b[1].as_f64().unwrap());
+            assert!((len - c["hinge_length_mm"].as_f64().unwrap()).abs() < 1e-9);
+        }
+        assert_eq!(
+            d["fabrication"]["hinges"].as_array().unwrap().len(),
+            bill["creases"].as_array().unwrap().len()
+        );
+    }
+    assert_eq!(jsons, designs.len());
 }

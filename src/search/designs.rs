@@ -3,7 +3,7 @@
 //! for the report; the export metadata of a design; a recorded design's robustness
 //! measured again.
 
-use super::measure::{checked_pattern, measure_robustness};
+use super::measure::{checked_pattern, judged_times, measure_robustness, thick_design};
 use super::options::{SearchError, SearchOptions};
 use super::output::OutputDir;
 use super::plan::Plan;
@@ -62,7 +62,7 @@ pub(super) fn write_designs(
         let work = pool.install(|| {
             recs.par_iter()
                 .enumerate()
-                .map(|(k, rec)| build_design(task, plan, c * 256 + k + 1, rec))
+                .map(|(k, rec)| build_design(task, plan, c * 256 + k + 1, rec, opts.sweep))
                 .collect::<Result<Vec<_>, _>>()
         })?;
         // Listed before they are written, so a kill leaves nothing unlisted.
@@ -97,17 +97,22 @@ struct DesignWork {
     pattern: Pattern,
     meta: DesignMeta,
     options: ExportOptions,
+    /// The thick panels for the report's view and bill (`[fabrication]` only).
+    thick: Option<serde_json::Value>,
 }
 
-/// Rebuild the design of `rec` (ranked `rank`, from 1) and its `designs/<id>.json`.
+/// Rebuild the design of `rec` (ranked `rank`, from 1) and its `designs/<id>.json`
+/// (`sweep`: the search's dense sweep, on which a thick design's folds were measured).
 fn build_design(
     task: &Task,
     plan: &Plan,
     rank: usize,
     rec: &AlternativeRecord,
+    sweep: usize,
 ) -> Result<DesignWork, SearchError> {
     let (model, free, full, modes) = design_of(task, &plan.graph(task, rec.graph), rec)?;
     let design = Evaluated::new(&model.plan, full.clone(), modes);
+    let thick = thick_of(task, &model, &design, rec, sweep)?;
     let pattern = design.pattern(&sample_times(model.t_max, 33));
     let meta = design_meta(task, &model, rec);
     let all_vars: BTreeMap<String, f64> = model
@@ -144,6 +149,7 @@ fn build_design(
         "obstacle_free": rec.obstacle_free,
         "robustness": rec.robustness,
         "requirements": rec.requirements,
+        "fabrication": thick.as_ref().map(|t| &t.doc),
         "rank": rank,
         "pattern": pattern,
         "meta": meta,
@@ -157,6 +163,9 @@ fn build_design(
             name: id.clone(),
             ..Default::default()
         },
+        thick: thick
+            .as_ref()
+            .map(|t| crate::export::report::thick_json(&pattern, &t.design)),
         id,
         pattern,
         meta,
@@ -179,15 +188,9 @@ fn write_design(
     })?;
     if !export {
         progress.inc(1);
-        return Ok(report_design(
-            &w.rec,
-            w.threshold,
-            w.pattern,
-            w.meta,
-            path,
-            None,
-            None,
-        ));
+        let mut card = report_design(&w.rec, w.threshold, w.pattern, w.meta, path, None, None);
+        card.thick = w.thick;
+        return Ok(card);
     }
     let out = out_dir.path(&format!("designs/{id}"));
     let files = export::write_all(&out, &w.pattern, &w.meta, &w.options)
@@ -198,7 +201,7 @@ fn write_design(
         eprintln!("BUG: the exported FOLD file of {id} fails verification");
     }
     progress.inc(1);
-    Ok(report_design(
+    let mut card = report_design(
         &w.rec,
         w.threshold,
         w.pattern,
@@ -206,7 +209,55 @@ fn write_design(
         path,
         Some(files),
         Some(check),
-    ))
+    );
+    card.thick = w.thick;
+    Ok(card)
+}
+
+/// A design's thick panels (issue 32): the bill, the hinge axes and the check, for the
+/// design JSON and the report.
+pub(crate) struct ThickOf {
+    /// `"fabrication"` of `designs/<id>.json`: `bill`, `hinges`, `check`.
+    pub doc: serde_json::Value,
+    /// The panels, built on the checked pattern (the arm with its copies).
+    pub design: crate::fabricate::ThickDesign,
+}
+
+/// The thick panels of a kept design, rebuilt as the search built them (the same sweep,
+/// the same folds), `None` without `[fabrication]`.
+fn thick_of(
+    task: &Task,
+    model: &Model,
+    design: &Evaluated<'_>,
+    rec: &AlternativeRecord,
+    sweep: usize,
+) -> Result<Option<ThickOf>, SearchError> {
+    let Some(spec) = &task.fabrication else {
+        return Ok(None);
+    };
+    let times = judged_times(task, model.t_max, sweep);
+    let arm = design.pattern(&times);
+    let pat = checked_pattern(task, &arm).map_err(SearchError::Export)?;
+    let built = thick_design(spec, &pat).map_err(|e| SearchError::Export(e.to_string()))?;
+    let hinges: Vec<_> = built
+        .hinges
+        .iter()
+        .map(|h| {
+            json!({
+                "edge": h.edge,
+                "vertices": h.vertices,
+                "facets": h.facets,
+                "axis": h.axis,
+                "setback": h.setback,
+            })
+        })
+        .collect();
+    let doc = json!({
+        "bill": built.bill(),
+        "hinges": hinges,
+        "check": rec.fabrication,
+    });
+    Ok(Some(ThickOf { doc, design: built }))
 }
 
 /// The model of a record's graph and candidate, and the record's free variables, all
