@@ -76,6 +76,7 @@ fn sample_designs() -> Vec<ReportDesign> {
         design_file: None,
         files: None,
         verify: None,
+        thick: None,
     };
     vec![
         design("d-arm", 2, None, pa, ma, Some(rob_a)),
@@ -836,6 +837,7 @@ fn report_draws_every_shape_of_the_scene_once() {
         design_file: None,
         files: None,
         verify: None,
+        thick: None,
     };
     let input = ReportInput {
         summary: ReportSummary {

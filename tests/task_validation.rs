@@ -1083,3 +1083,128 @@ fn meshes_over_the_limits_are_refused() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_fabrication_table_is_read_with_its_defaults() {
+    use foldsynth::task::fabrication::{FabMethod, Sides};
+    assert!(
+        Task::from_toml_str(BASE, "ok.toml")
+            .unwrap()
+            .fabrication
+            .is_none()
+    );
+    let t = Task::from_toml_str(
+        &(BASE.to_owned() + "[fabrication]\nthickness = 2\nscale = 100\n"),
+        "ok.toml",
+    )
+    .unwrap();
+    let f = t.fabrication.unwrap();
+    assert_eq!((f.thickness, f.scale), (2.0, 100.0));
+    assert_eq!((f.method, f.sides), (FabMethod::Tapered, Sides::One));
+    assert_eq!((f.hinge_gap, f.min_width), (0.5, 2.0));
+    // 2 mm at 100 mm per unit, one side: every panel point within 0.02 units of its facet.
+    assert_eq!(f.reach_units(), 0.02);
+    let t = Task::from_toml_str(
+        &(BASE.to_owned()
+            + "[fabrication]\nthickness = \"3/2\"\nscale = 50\nmethod = \"tapered\"\nsides = \"both\"\nhinge_gap = 0\nmin_width = 1\n"),
+        "ok.toml",
+    )
+    .unwrap();
+    let f = t.fabrication.unwrap();
+    assert_eq!(
+        (f.thickness, f.sides, f.hinge_gap, f.min_width),
+        (1.5, Sides::Both, 0.0, 1.0)
+    );
+    assert_eq!(f.reach_units(), 0.015);
+    // The table is part of the task: another thickness is another task (a resume refuses it).
+    let a = Task::from_toml_str(
+        &(BASE.to_owned() + "[fabrication]\nthickness = 2\nscale = 100\n"),
+        "a.toml",
+    )
+    .unwrap();
+    let b = Task::from_toml_str(
+        &(BASE.to_owned() + "[fabrication]\nthickness = 3\nscale = 100\n"),
+        "a.toml",
+    )
+    .unwrap();
+    assert_ne!(a.digest, b.digest);
+}
+
+#[test]
+fn bad_fabrication_values_are_refused_with_file_and_field() {
+    let with = |extra: &str| BASE.to_owned() + "[fabrication]\n" + extra;
+    for (text, field, words) in [
+        (
+            "thickness = 0\nscale = 100\n",
+            "fabrication.thickness",
+            &["(0, "][..],
+        ),
+        (
+            "thickness = -2\nscale = 100\n",
+            "fabrication.thickness",
+            &["-2"][..],
+        ),
+        (
+            "thickness = nan\nscale = 100\n",
+            "fabrication.thickness",
+            &["not a finite number"][..],
+        ),
+        (
+            "thickness = inf\nscale = 100\n",
+            "fabrication.thickness",
+            &["not a finite number"][..],
+        ),
+        ("scale = 100\n", "fabrication.thickness", &["missing"][..]),
+        (
+            "thickness = 2\nscale = 0\n",
+            "fabrication.scale",
+            &["(0, "][..],
+        ),
+        (
+            "thickness = 2\n",
+            "fabrication.scale",
+            &["missing", "mm per paper unit"][..],
+        ),
+        (
+            "thickness = 2\nscale = 100\nmethod = \"glued\"\n",
+            "fabrication.method",
+            &["\"glued\"", "\"tapered\""][..],
+        ),
+        (
+            "thickness = 2\nscale = 100\nsides = \"three\"\n",
+            "fabrication.sides",
+            &["\"one\"", "\"both\""][..],
+        ),
+        (
+            "thickness = 2\nscale = 100\nhinge_gap = -0.5\n",
+            "fabrication.hinge_gap",
+            &["[0, "][..],
+        ),
+        (
+            "thickness = 2\nscale = 100\nmin_width = 150\n",
+            "fabrication.min_width",
+            &["no panel"][..],
+        ),
+        // One side: two panels reach 2·thickness/scale; with the default clearance 0.01 the
+        // limit is thickness/scale < 0.495 of G0's unit crease.
+        (
+            "thickness = 50\nscale = 100\n",
+            "fabrication.thickness",
+            &["leaves no panel"][..],
+        ),
+        (
+            "thickness = 2\nscale = 100\nwidth = 3\n",
+            "fabrication",
+            &["width"][..],
+        ),
+    ] {
+        let e = err(&with(text));
+        if field == "fabrication" {
+            assert!(e.to_string().contains("width"), "{e}");
+            continue;
+        }
+        assert_err(&e, field, words);
+    }
+    // Just below the limit is a task (0.49 · 2 + 0.01 < 1).
+    Task::from_toml_str(&with("thickness = 49\nscale = 100\n"), "ok.toml").unwrap();
+}

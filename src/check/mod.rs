@@ -41,6 +41,7 @@ pub mod robustness;
 pub mod rotated_copy;
 pub mod self_intersection;
 pub mod shapes;
+pub mod thick;
 pub mod tri_tri;
 pub mod triangulate;
 

@@ -67,6 +67,7 @@ use crate::geom::V3;
 use crate::kinematics::{Scalar, wrap_angle};
 use crate::optimize::{Acceptance, Robust};
 use crate::scene::{Containment, HalfSpace};
+use crate::task::fabrication::Fabrication;
 use crate::task::terms::Requirements;
 use crate::task::{Robustness, Task};
 use std::cell::{Cell, OnceCell, RefCell};
@@ -118,6 +119,22 @@ pub struct RobustSpec {
     /// The task's requirements; the block reads the fold-angle limits (`max_fold`,
     /// `fold_limits`).
     pub requirements: Requirements,
+    /// The task's `[fabrication]` (issue 32): with it, every gap grows by the panels' reach
+    /// (see [`RobustModel::thick_inflation`]) and every crease's fold is bounded by
+    /// [`thick_fold_limit`]; `None`: zero-thickness facets, as before.
+    pub fabrication: Option<Fabrication>,
+}
+
+/// The largest setback (paper units, G0's crease = 1) the optimizer lets a tapered panel's
+/// trimming take off its facet at a crease: a tenth of G0's crease (1 cm on a 10 cm
+/// gripper). The setback at fold angle ρ is `reach · tan(|ρ|/2)`, so it bounds the fold.
+pub const MAX_SETBACK: f64 = 0.1;
+
+/// The largest `|ρ|` (rad) at which the tapered setback `reach · tan(|ρ|/2)` of `spec`'s
+/// panels stays within [`MAX_SETBACK`]: `2 atan(MAX_SETBACK / reach)`, below π for every
+/// thickness (a crease of thick panels never folds flat).
+pub fn thick_fold_limit(spec: &Fabrication) -> f64 {
+    2.0 * (MAX_SETBACK / spec.reach_units()).atan()
 }
 
 impl RobustSpec {
@@ -130,6 +147,7 @@ impl RobustSpec {
             sweep: sweep.max(2),
             scene: task.scene.clone(),
             requirements: task.requirements.clone(),
+            fabrication: task.fabrication,
         }
     }
 }
@@ -283,7 +301,13 @@ impl RobustModel {
         let creases: Vec<usize> = (0..plan.creases.len())
             .filter(|&c| plan.creases[c].drive.is_none())
             .collect();
-        let fold_limits = resolve_fold_limits(model, &creases, &spec.requirements)?;
+        let mut fold_limits = resolve_fold_limits(model, &creases, &spec.requirements)?;
+        if let Some(fab) = &spec.fabrication {
+            let thick = thick_fold_limit(fab);
+            for l in &mut fold_limits {
+                *l = Some(l.map_or(thick, |m| m.min(thick)));
+            }
+        }
         let (nv, ni, nf, nc) = (
             plan.vertices.len(),
             plan.internal.len(),
@@ -580,11 +604,31 @@ impl RobustModel {
             Level::Setting => 0.0,
             _ => CLEARANCE_FLOOR,
         };
-        match pair.kind {
+        let base = match pair.kind {
             PairKind::Obstacle { k: c, .. } => {
                 self.pairs.obstacles[c].radius + s.obstacle_clearance * k + floor
             }
             _ => s.clearance * k + floor,
+        };
+        match self.spec.fabrication {
+            None => base,
+            Some(_) => base + self.thick_inflation(pair.kind),
+        }
+    }
+
+    /// What `[fabrication]` adds to a pair's gap (paper units): every point of a thick panel
+    /// lies within `reach` of its facet, so facets `clearance + 2·reach` apart (a facet and
+    /// an obstacle `obstacle_clearance + reach`) keep their panels `clearance` apart. For
+    /// facets meeting at a point the gap is the chord at unit distance from it: the panels
+    /// keep the clearance there, and nearer the point the tapered trimming (checked by
+    /// `check::thick`) keeps them apart. 0 without `[fabrication]`.
+    pub fn thick_inflation(&self, kind: PairKind) -> f64 {
+        let Some(fab) = &self.spec.fabrication else {
+            return 0.0;
+        };
+        match kind {
+            PairKind::Obstacle { .. } => fab.reach_units(),
+            _ => 2.0 * fab.reach_units(),
         }
     }
 
@@ -621,7 +665,11 @@ impl RobustModel {
             Level::Setting => 0.0,
             _ => CLEARANCE_FLOOR,
         };
-        self.spec.settings.obstacle_clearance * level.factor() + floor
+        let base = self.spec.settings.obstacle_clearance * level.factor() + floor;
+        match &self.spec.fabrication {
+            None => base,
+            Some(fab) => base + fab.reach_units(),
+        }
     }
 
     /// The margin every vertex keeps at `t` (rad), `None` at the flat state.

@@ -3,7 +3,7 @@
 //! for the report; the export metadata of a design; a recorded design's robustness
 //! measured again.
 
-use super::measure::{checked_pattern, measure_robustness};
+use super::measure::{checked_pattern, judged_times, measure_robustness, thick_design};
 use super::options::{SearchError, SearchOptions};
 use super::output::OutputDir;
 use super::plan::Plan;
@@ -63,7 +63,7 @@ pub(super) fn write_designs(
         let work = pool.install(|| {
             recs.par_iter()
                 .enumerate()
-                .map(|(k, rec)| build_design(task, plan, c * 256 + k + 1, rec))
+                .map(|(k, rec)| build_design(task, plan, c * 256 + k + 1, rec, opts.sweep))
                 .collect::<Result<Vec<_>, _>>()
         })?;
         // Listed before they are written, so a kill leaves nothing unlisted.
@@ -138,17 +138,22 @@ struct DesignWork {
     pattern: Pattern,
     meta: DesignMeta,
     options: ExportOptions,
+    /// The thick panels for the report's view and bill (`[fabrication]` only).
+    thick: Option<serde_json::Value>,
 }
 
-/// Rebuild the design of `rec` (ranked `rank`, from 1) and its `designs/<id>.json`.
+/// Rebuild the design of `rec` (ranked `rank`, from 1) and its `designs/<id>.json`
+/// (`sweep`: the search's dense sweep, on which a thick design's folds were measured).
 fn build_design(
     task: &Task,
     plan: &Plan,
     rank: usize,
     rec: &AlternativeRecord,
+    sweep: usize,
 ) -> Result<DesignWork, SearchError> {
     let (model, free, full, modes) = design_of(task, &plan.graph(task, rec.graph), rec)?;
     let design = Evaluated::new(&model.plan, full.clone(), modes);
+    let thick = thick_of(task, &model, &design, rec, sweep)?;
     let pattern = design.pattern(&sample_times(model.t_max, 33));
     let meta = design_meta(task, &model, rec);
     let all_vars: BTreeMap<String, f64> = model
@@ -185,6 +190,7 @@ fn build_design(
         "obstacle_free": rec.obstacle_free,
         "robustness": rec.robustness,
         "requirements": rec.requirements,
+        "fabrication": thick.as_ref().map(|t| &t.doc),
         "rank": rank,
         "pattern": pattern,
         "meta": meta,
@@ -198,6 +204,9 @@ fn build_design(
             name: id.clone(),
             ..Default::default()
         },
+        thick: thick
+            .as_ref()
+            .map(|t| crate::export::report::thick_json(&pattern, &t.design)),
         id,
         rank,
         pattern,
@@ -282,7 +291,7 @@ fn write_design(
         None => None,
     };
     progress.inc(1);
-    Ok(report_design(
+    let mut card = report_design(
         &w.rec,
         w.threshold,
         w.pattern,
@@ -290,7 +299,55 @@ fn write_design(
         path,
         written,
         check,
-    ))
+    );
+    card.thick = w.thick;
+    Ok(card)
+}
+
+/// A design's thick panels (issue 32): the bill, the hinge axes and the check, for the
+/// design JSON and the report.
+pub(crate) struct ThickOf {
+    /// `"fabrication"` of `designs/<id>.json`: `bill`, `hinges`, `check`.
+    pub doc: serde_json::Value,
+    /// The panels, built on the checked pattern (the arm with its copies).
+    pub design: crate::fabricate::ThickDesign,
+}
+
+/// The thick panels of a kept design, rebuilt as the search built them (the same sweep,
+/// the same folds), `None` without `[fabrication]`.
+fn thick_of(
+    task: &Task,
+    model: &Model,
+    design: &Evaluated<'_>,
+    rec: &AlternativeRecord,
+    sweep: usize,
+) -> Result<Option<ThickOf>, SearchError> {
+    let Some(spec) = &task.fabrication else {
+        return Ok(None);
+    };
+    let times = judged_times(task, model.t_max, sweep);
+    let arm = design.pattern(&times);
+    let pat = checked_pattern(task, &arm).map_err(SearchError::Export)?;
+    let built = thick_design(spec, &pat).map_err(|e| SearchError::Export(e.to_string()))?;
+    let hinges: Vec<_> = built
+        .hinges
+        .iter()
+        .map(|h| {
+            json!({
+                "edge": h.edge,
+                "vertices": h.vertices,
+                "facets": h.facets,
+                "axis": h.axis,
+                "setback": h.setback,
+            })
+        })
+        .collect();
+    let doc = json!({
+        "bill": built.bill(),
+        "hinges": hinges,
+        "check": rec.fabrication,
+    });
+    Ok(Some(ThickOf { doc, design: built }))
 }
 
 /// The model of a record's graph and candidate, and the record's free variables, all

@@ -5,7 +5,7 @@
 //! one [`AlternativeRecord`] out.
 
 use super::measure::{
-    checked_pattern, judge_requirements, judged_times, measure_robustness, obstacles,
+    checked_pattern, judge_requirements, judged_times, measure_robustness, measure_thick, obstacles,
 };
 use super::options::{Alternative, SearchOptions};
 use super::record::AlternativeRecord;
@@ -189,6 +189,7 @@ fn optimized_record(
         check_ms: 0.0,
         cycle: None,
         requirements: None,
+        fabrication: None,
     }
 }
 
@@ -269,6 +270,14 @@ fn judge(
             );
             rec.verification_failed = Some(true);
         }
+    }
+    // Thick panels (issue 32): built and tested only where every other check passed (the
+    // solids on the dense sweep are the most expensive check).
+    if let Some(pat) = checked_pattern
+        .as_ref()
+        .filter(|_| task.fabrication.is_some() && rec.passes_checks())
+    {
+        rec.fabrication = Some(measure_thick(task, model, &arm, pat));
     }
     // Margins are a design's: measured only where every check passed (with
     // `--post-check-only` most target-meeting alternatives fail one, and measuring them was

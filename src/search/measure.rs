@@ -2,12 +2,16 @@
 //! copy for two-armed tasks), the task's obstacles, and the design's robustness measured
 //! by `check::robustness` (for a new design and for a recorded one alike).
 
+use super::record::FabricationRecord;
 use crate::check::requirements::{self, JudgeInput, RequirementsReport};
 use crate::check::robustness::{self, RobustnessInput, RobustnessReport, UnitCreases};
+use crate::check::thick::ThickInput;
 use crate::check::{Cylinder, two_armed};
+use crate::fabricate::ThickDesign;
 use crate::model::Model;
 use crate::pattern::Pattern;
 use crate::task::Task;
+use crate::task::fabrication::Fabrication;
 
 /// The obstacles of the task as the checks take them.
 pub(super) fn obstacles(task: &Task) -> Vec<Cylinder> {
@@ -64,21 +68,7 @@ pub(super) fn measure_robustness(
         })
         .collect();
     let cylinders = obstacles(task);
-    // The arms of a two-armed gripper meet at a target on the rotation axis: their tips
-    // touch there by design (the copy of the gripping vertex is found by its flat position).
-    let tip = (pat.vertices.len() > n
-        && model
-            .targets
-            .iter()
-            .any(|t| t.point[0].abs() < 1e-9 && t.point[1].abs() < 1e-9))
-    .then(|| {
-        let g = model.gripping;
-        let q = [-arm.vertices[g][0], -arm.vertices[g][1]];
-        (n..pat.vertices.len())
-            .find(|&j| (pat.vertices[j][0] - q[0]).hypot(pat.vertices[j][1] - q[1]) <= 1e-9)
-            .map(|c| (g, c))
-    })
-    .flatten();
+    let tip = tip_pair(model, arm, pat);
     let input = RobustnessInput {
         pattern: pat,
         arm_faces: arm.faces.len(),
@@ -92,6 +82,73 @@ pub(super) fn measure_robustness(
         arm,
     };
     robustness::measure(&input).map_err(|e| e.to_string())
+}
+
+/// The arms of a two-armed gripper meet at a target on the rotation axis: their tips touch
+/// there by design. The gripping vertex and its copy (found by its flat position) in `pat`.
+fn tip_pair(model: &Model, arm: &Pattern, pat: &Pattern) -> Option<(usize, usize)> {
+    let n = arm.vertices.len();
+    (pat.vertices.len() > n
+        && model
+            .targets
+            .iter()
+            .any(|t| t.point[0].abs() < 1e-9 && t.point[1].abs() < 1e-9))
+    .then(|| {
+        let g = model.gripping;
+        let q = [-arm.vertices[g][0], -arm.vertices[g][1]];
+        (n..pat.vertices.len())
+            .find(|&j| (pat.vertices[j][0] - q[0]).hypot(pat.vertices[j][1] - q[1]) <= 1e-9)
+            .map(|c| (g, c))
+    })
+    .flatten()
+}
+
+/// The thick panels of the checked pattern `pat` (its frames: the dense sweep) for the
+/// task's `[fabrication]`, built for the largest folds seen on those frames.
+pub(super) fn thick_design(
+    spec: &Fabrication,
+    pat: &Pattern,
+) -> Result<ThickDesign, crate::fabricate::FabError> {
+    let ranges = crate::fabricate::fold_ranges(pat, &pat.frames);
+    crate::fabricate::build(pat, &ranges, spec)
+}
+
+/// A design made thick and its solids tested by `check::thick` on the frames of `pat` (the
+/// arm with its copies, on the dense sweep): the other arm and the obstacles included, the
+/// tips of a gripper's arms allowed to touch.
+pub(super) fn measure_thick(
+    task: &Task,
+    model: &Model,
+    arm: &Pattern,
+    pat: &Pattern,
+) -> FabricationRecord {
+    let Some(spec) = &task.fabrication else {
+        return FabricationRecord {
+            refused: Some("the task has no [fabrication] table".to_string()),
+            check: None,
+        };
+    };
+    match thick_design(spec, pat) {
+        Err(e) => FabricationRecord {
+            refused: Some(e.to_string()),
+            check: None,
+        },
+        Ok(design) => {
+            let touching: Vec<(usize, usize)> = tip_pair(model, arm, pat).into_iter().collect();
+            let report = crate::check::thick::check(&ThickInput {
+                pattern: pat,
+                design: &design,
+                clearance: task.robustness.clearance,
+                obstacle_clearance: task.robustness.obstacle_clearance,
+                obstacles: &task.scene.obstacles,
+                touching: &touching,
+            });
+            FabricationRecord {
+                refused: None,
+                check: Some(report),
+            }
+        }
+    }
 }
 
 /// The states the judges look at: the dense sweep of `n` states, with every t a term of

@@ -84,6 +84,61 @@ pub struct AlternativeRecord {
     /// targets and area judged again on the dense sweep by `check::requirements` (issue 31).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub requirements: Option<crate::check::requirements::RequirementsReport>,
+    /// With `[fabrication]`, for designs that pass every other check: the thick panels built
+    /// and tested on the dense sweep (issue 32); `None` when the task has no such table.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fabrication: Option<FabricationRecord>,
+}
+
+/// A design made thick (issue 32): why the construction refused it, or the independent
+/// check of its solids on the dense sweep.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FabricationRecord {
+    /// Why the design cannot be built (names the crease or facet), if so.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refused: Option<String>,
+    /// The thick-panel check ([`crate::check::thick`]), when built.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub check: Option<crate::check::thick::ThickReport>,
+}
+
+impl FabricationRecord {
+    /// Built, and its solids kept every clearance on the sweep.
+    pub fn passes(&self) -> bool {
+        self.refused.is_none() && self.check.as_ref().is_some_and(|c| c.passes())
+    }
+
+    /// Why it fails, in words (`None` when it passes).
+    pub fn failure(&self) -> Option<String> {
+        if let Some(r) = &self.refused {
+            return Some(format!("cannot be built: {r}"));
+        }
+        let hit = self.check.as_ref()?.first_failure.as_ref()?;
+        Some(match hit.kind.as_str() {
+            "obstacle" => format!(
+                "thick panel {} is {} from obstacle {} at t = {} (needs {})",
+                hit.facets[0],
+                crate::text::num(hit.distance),
+                hit.obstacle.as_deref().unwrap_or("?"),
+                crate::text::num(hit.t),
+                crate::text::num(self.check.as_ref()?.obstacle_clearance),
+            ),
+            "crossing" => format!(
+                "thick panels {} and {} cross at t = {}",
+                hit.facets[0],
+                hit.facets[1],
+                crate::text::num(hit.t)
+            ),
+            _ => format!(
+                "thick panels {} and {} are {} apart at t = {} (needs {})",
+                hit.facets[0],
+                hit.facets[1],
+                crate::text::num(hit.distance),
+                crate::text::num(hit.t),
+                crate::text::num(self.check.as_ref()?.clearance),
+            ),
+        })
+    }
 }
 
 impl AlternativeRecord {
@@ -106,6 +161,10 @@ impl AlternativeRecord {
             && self.verification_failed == Some(false)
             && self.cycle.as_ref().is_none_or(|c| c.passes)
             && self.requirements.as_ref().is_none_or(requirements_hold)
+            && self
+                .fabrication
+                .as_ref()
+                .is_none_or(FabricationRecord::passes)
     }
 
     /// Whether the margins the run requires hold on the sweep. With the robustness

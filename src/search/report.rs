@@ -331,6 +331,7 @@ pub(super) fn report_design(
         design_file: Some(design_file),
         files,
         verify,
+        thick: None,
     }
 }
 

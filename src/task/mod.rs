@@ -39,6 +39,7 @@ mod check;
 mod constraints;
 mod ctx;
 mod drive;
+mod fab_table;
 pub mod fabrication;
 mod initial;
 mod meshes;
@@ -126,6 +127,10 @@ pub struct Task {
     /// `[constraints] kawasaki = true`: every internal vertex of even degree folds flat
     /// (Kawasaki's condition, imposed by the model); off when absent.
     pub kawasaki: bool,
+    /// `[fabrication]`: the panels' thickness and how they are built (issue 32); the
+    /// optimizer then keeps the thick panels clear (see `docs/tasks.md`). `None` when absent:
+    /// zero-thickness facets, as before.
+    pub fabrication: Option<fabrication::Fabrication>,
 }
 
 /// Symmetry of a design task.

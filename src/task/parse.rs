@@ -10,8 +10,8 @@ use serde::Deserialize;
 use super::ctx::syntax_error;
 use super::{
     Ctx, InitialGraph, N_MAX_LIMIT, Symmetry, Task, TaskError, VertexType, bounds, check,
-    constraints, digest_with_meshes, initial, meshes::Meshes, motion, objective, obstacles,
-    robustness,
+    constraints, digest_with_meshes, fab_table, initial, meshes::Meshes, motion, objective,
+    obstacles, robustness,
 };
 
 #[derive(Deserialize)]
@@ -32,6 +32,7 @@ struct RawTask {
     #[serde(default)]
     obstacles: Vec<obstacles::RawObstacle>,
     copies: Option<obstacles::RawCopies>,
+    fabrication: Option<fab_table::RawFabrication>,
 }
 
 #[derive(Deserialize)]
@@ -131,6 +132,7 @@ impl<'a> Draft<'a> {
             constraints::build(&cx, raw.constraints.as_ref(), motion, &initial)?;
         let scene = scene(&cx, &raw, legacy, containment, &mut meshes)?;
         let robustness = robustness::build(&cx, raw.robustness.as_ref(), &initial)?;
+        let fabrication = fab_table::build(&cx, raw.fabrication.as_ref(), &initial, &robustness)?;
 
         Ok(Task {
             name: name.trim().to_string(),
@@ -149,6 +151,7 @@ impl<'a> Draft<'a> {
             requirements,
             robustness,
             kawasaki: constraints::kawasaki(raw.constraints.as_ref()),
+            fabrication,
         })
     }
 }

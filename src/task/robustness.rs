@@ -89,7 +89,7 @@ pub(crate) struct RawRobustness {
 }
 
 /// The length unit of the task: G0's shortest crease (1 for the thesis's tasks).
-fn unit_length(g0: &InitialGraph) -> f64 {
+pub(crate) fn unit_length(g0: &InitialGraph) -> f64 {
     g0.creases
         .iter()
         .map(|c| {

@@ -143,6 +143,7 @@
       tr.appendChild(el('td', {}, v));
       facts.appendChild(tr);
     }
+    billTable(d.thick ? d.thick.bill : null);
     const files = document.getElementById('detail-files');
     files.replaceChildren();
     if (d.files.length) {
@@ -154,6 +155,30 @@
     drawCreasePattern(d);
     if (view) view.show(d);
     setFrame(d.geometry.frames.length ? d.geometry.frames.length - 1 : 0);
+  }
+
+  // The bill of the build of a thick design: the setting, every crease as a hinge, every
+  // panel; hidden for a design without [fabrication].
+  function billTable(bill) {
+    const table = document.getElementById('detail-bill');
+    const body = table.tBodies[0];
+    body.replaceChildren();
+    table.hidden = !bill;
+    if (!bill) return;
+    const row = (cells, head) => {
+      const tr = el('tr');
+      cells.forEach((c, i) => tr.appendChild(el(head || i === 0 ? 'th' : 'td', {}, String(c))));
+      body.appendChild(tr);
+    };
+    const mm = (x) => x.toFixed(2);
+    row(['setting', bill.method + ', ' + bill.sides + ' side(s), ' + mm(bill.thickness_mm) + ' mm thick, ' + mm(bill.scale_mm_per_unit) + ' mm per unit, hinge gap ' + mm(bill.hinge_gap_mm) + ' mm']);
+    row(['crease', 'vertices', 'panels', 'largest fold (°)', 'setback +/− (mm)', 'gap (mm)', 'hinge length (mm)'], true);
+    for (const c of bill.creases) {
+      row(['e' + c.edge, c.vertices.join('–'), c.facets.join(', '), c.largest_fold_deg.toFixed(1), mm(c.setback_mm[0]) + ' / ' + mm(c.setback_mm[1]), mm(c.gap_mm), mm(c.hinge_length_mm)]);
+    }
+    row(['panel', 'thickness (mm)', 'area (mm²)', 'corners'], true);
+    for (const p of bill.panels) row(['f' + p.facet, mm(p.thickness_mm), p.area_mm2.toFixed(0), p.outline_mm.length]);
+    row(['total area (mm²)', bill.total_area_mm2.toFixed(0)]);
   }
 
   function robustnessFacts(r) {
@@ -420,12 +445,26 @@
       });
       edgeGeo.setAttribute('color', new T.BufferAttribute(colors, 3));
       const offset = { polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 };
+      // Thick panels ([fabrication]): every panel's triangles, one vertex per corner, moved
+      // by its facet's rigid motion in setFrame; they replace the zero-thickness facets.
+      let thickGeo = null;
+      if (d.thick && d.thick.panels.length) {
+        const count = d.thick.panels.reduce((s, p) => s + p.triangles.length, 0);
+        thickGeo = new T.BufferGeometry();
+        thickGeo.setAttribute('position', new T.BufferAttribute(new Float32Array(count * 3), 3));
+      }
       const arm = (front, back, lines) => {
         const group = new T.Group();
         const a = new T.Mesh(faceGeo, new T.MeshLambertMaterial(Object.assign({ color: front, side: T.FrontSide }, offset)));
         const b = new T.Mesh(faceGeo, new T.MeshLambertMaterial(Object.assign({ color: back, side: T.BackSide }, offset)));
         const l = new T.LineSegments(edgeGeo, new T.LineBasicMaterial({ vertexColors: true, transparent: lines < 1, opacity: lines }));
-        for (const o of [a, b, l]) {
+        const parts = [a, b, l];
+        if (thickGeo) {
+          a.visible = false;
+          b.visible = false;
+          parts.push(new T.Mesh(thickGeo, new T.MeshLambertMaterial({ color: front, side: T.FrontSide })));
+        }
+        for (const o of parts) {
           o.frustumCulled = false; // the bounds change with t
           group.add(o);
         }
@@ -490,7 +529,7 @@
       }
       for (const o of drawScene(world, d.goals || [], center, radius)) content.add(o);
       scene.add(content);
-      current = { d: d, frames: frames, faceGeo: faceGeo, edgeGeo: edgeGeo, marker: marker, gv: gv, n: n };
+      current = { d: d, frames: frames, faceGeo: faceGeo, edgeGeo: edgeGeo, thickGeo: thickGeo, marker: marker, gv: gv, n: n };
       // Front, right, above: the folded arm and its target in view.
       const dir = new T.Vector3(0.55, -1.0, 0.6).normalize();
       const dist = (radius / Math.sin((camera.fov * Math.PI) / 360)) * 0.9;
@@ -523,8 +562,39 @@
         ep.setXYZ(2 * k + 1, at(e[1], 0), at(e[1], 1), at(e[1], 2));
       });
       ep.needsUpdate = true;
+      if (current.thickGeo) moveThick(current.d, current.thickGeo, at);
       if (current.marker) current.marker.position.set(at(current.gv, 0), at(current.gv, 1), at(current.gv, 2));
       render();
+    }
+
+    // Each thick panel moved by its facet's rigid motion: the orthonormal frame of three of
+    // the facet's corners in the flat layout taken to theirs at the frame (`at`).
+    function moveThick(d, geo, at) {
+      const flat = d.geometry.flat;
+      const frameOf = (p) => {
+        const e1 = p[1].clone().sub(p[0]).normalize();
+        const n = e1.clone().cross(p[2].clone().sub(p[0])).normalize();
+        return [p[0], e1, n.clone().cross(e1), n];
+      };
+      const pos = geo.attributes.position;
+      let k = 0;
+      for (const panel of d.thick.panels) {
+        const c = panel.corners;
+        const [p0, a1, a2, an] = frameOf(c.map((v) => new T.Vector3(flat[v][0], flat[v][1], 0)));
+        const [q0, b1, b2, bn] = frameOf(c.map((v) => new T.Vector3(at(v, 0), at(v, 1), at(v, 2))));
+        const vs = panel.vertices;
+        for (const i of panel.triangles) {
+          const x = new T.Vector3(vs[3 * i], vs[3 * i + 1], vs[3 * i + 2]).sub(p0);
+          const y = q0.clone()
+            .add(b1.clone().multiplyScalar(x.dot(a1)))
+            .add(b2.clone().multiplyScalar(x.dot(a2)))
+            .add(bn.clone().multiplyScalar(x.dot(an)));
+          pos.setXYZ(k, y.x, y.y, y.z);
+          k += 1;
+        }
+      }
+      pos.needsUpdate = true;
+      geo.computeVertexNormals();
     }
 
     // Names of the objects in the view (arms, obstacles, boxes, goals), in drawing order.

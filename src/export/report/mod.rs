@@ -20,6 +20,9 @@
 //! crease pattern, with its figures and files below.
 
 mod scene_data;
+mod thick_view;
+
+pub use thick_view::thick_json;
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
@@ -128,6 +131,9 @@ pub struct ReportDesign {
     pub files: Option<Files>,
     /// The result of verifying its FOLD file, when exported.
     pub verify: Option<VerifyReport>,
+    /// Its thick panels and the bill of the build ([`thick_json`]), for a task with
+    /// `[fabrication]`: drawn in the 3D view, the bill as a table.
+    pub thick: Option<Value>,
 }
 
 /// Everything the report shows.
@@ -347,6 +353,7 @@ fn design_json(out_dir: &Path, d: &ReportDesign) -> Result<Value> {
         "targets": m.targets.iter().map(|t| [r4(t.p[0]), r4(t.p[1]), r4(t.p[2])]).collect::<Vec<_>>(),
         "trajectory": m.trajectory.iter().map(|q| [r4(q[0]), r4(q[1]), r4(q[2])]).collect::<Vec<_>>(),
         "goals": scene_data::goals_json(m),
+        "thick": d.thick,
     }))
 }
 
@@ -743,7 +750,7 @@ fn designs_section(designs: &[ReportDesign]) -> String {
 black dot and line: the gripping vertex and its path; green: targets, trajectory, goal lines, planes and surfaces; grey: obstacles; purple: boxes to stay inside; lighter: the other copies of the arm.</figcaption></figure>\
 <figure class=\"cp\"><svg id=\"cp\" xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 100 100\" role=\"img\" aria-label=\"crease pattern\"></svg>\
 <figcaption>crease pattern: red mountain, blue valley, grey flat, black boundary, thick: driven crease; vertices v1, v2, … as in the rule sequence; circled: the gripping vertex</figcaption></figure></div>\
-<table class=\"facts\" id=\"detail-facts\"><tbody></tbody></table><p class=\"files\" id=\"detail-files\"></p></article></div>";
+<table class=\"facts\" id=\"detail-facts\"><tbody></tbody></table><table class=\"facts\" id=\"detail-bill\" hidden><caption>bill of the build</caption><tbody></tbody></table><p class=\"files\" id=\"detail-files\"></p></article></div>";
     }
     s += "</section>\n";
     s
