@@ -291,15 +291,7 @@ fn write_design(
         None => None,
     };
     progress.inc(1);
-    let mut card = report_design(
-        &w.rec,
-        w.threshold,
-        w.pattern,
-        w.meta,
-        path,
-        written,
-        check,
-    );
+    let mut card = report_design(&w.rec, w.threshold, w.pattern, w.meta, path, written, check);
     card.thick = w.thick;
     Ok(card)
 }
