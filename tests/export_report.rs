@@ -349,15 +349,20 @@ fn search_writes_the_report_names_it_and_numbers_the_gripping_vertex_once() {
     let stdout = String::from_utf8_lossy(&o.stdout);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{stdout}\n{stderr}");
+    // The files close the output: the report, the summary, the records (issue 35 added the
+    // last); with 6 designs, all under the default --export 20, no "design files" line.
     let lines: Vec<&str> = stdout.lines().collect();
     let n = lines.len();
     assert_eq!(
-        lines[n - 2],
-        format!("report: {}", out.join("report.html").display())
-    );
-    assert_eq!(
-        lines[n - 1],
-        format!("summary: {}", out.join("summary.json").display())
+        lines[n - 3..],
+        [
+            format!("report: {}", out.join("report.html").display()),
+            format!("summary: {}", out.join("summary.json").display()),
+            format!(
+                "records: {} (and alternatives.parquet)",
+                out.join("alternatives.jsonl").display()
+            ),
+        ]
     );
     for phase in [
         "enumerate graphs: ",
