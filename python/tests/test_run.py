@@ -177,7 +177,11 @@ def test_an_exception_from_the_callback_stops_the_search(task, tmp_path):
             raise Stop
 
     with pytest.raises(Stop):
-        foldsynth.synthesize(task, out=tmp_path / "r", n_max=1, starts=4, export=False, progress=stop)
+        # N_max 2 on one thread runs for seconds: the callback hears the optimize phase
+        # long before the search ends (N_max 1 could finish between two polls).
+        foldsynth.synthesize(
+            task, out=tmp_path / "r", n_max=N_MAX, starts=STARTS, export=False, jobs=1, progress=stop
+        )
     assert not foldsynth.Run.open(tmp_path / "r").finished
 
 
