@@ -69,22 +69,14 @@ for ply in ["rigid", "hinge"]:
     res[ply] = {"version": doc.dxfversion, "layers": layers, "cut": cut,
                 "labels": [t.dxf.text for t in msp.query("TEXT")],
                 "lines": {l: len(msp.query(f"LINE[layer=='{l}']")) for l in ["CUT", "SCORE", "MOUNTAIN", "VALLEY"]}}
-import zipfile, xml.etree.ElementTree as ET
+import zipfile
 def meshes_3mf(path):
-    # The model part is the one _rels/.rels names (OPC); trimesh only looks for
-    # 3D/3dmodel.model, so read the XML here and judge the meshes with trimesh.
-    z = zipfile.ZipFile(path)
-    rels = ET.fromstring(z.read("_rels/.rels"))
-    target = [r.get("Target") for r in rels if r.get("Type").endswith("/3dmodel")][0].lstrip("/")
-    root = ET.fromstring(z.read(target))
-    assert root.get("unit") == "millimeter"
-    ns = {"c": "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"}
-    out = []
-    for obj in root.iter("{%s}object" % ns["c"]):
-        v = [[float(x.get(a)) for a in "xyz"] for x in obj.iter("{%s}vertex" % ns["c"])]
-        f = [[int(x.get(a)) for a in ("v1", "v2", "v3")] for x in obj.iter("{%s}triangle" % ns["c"])]
-        out.append(trimesh.Trimesh(vertices=v, faces=f, process=True))
-    return out
+    # trimesh's own 3MF reader: it finds the model at 3D/3dmodel.model, the part name our
+    # archives use (threemf writes 3D/model.model; export::print re-packs it).
+    assert "3D/3dmodel.model" in zipfile.ZipFile(path).namelist()
+    scene = trimesh.load(path)
+    meshes = list(scene.dump()) if isinstance(scene, trimesh.Scene) else [scene]
+    return [trimesh.Trimesh(vertices=m.vertices, faces=m.faces, process=True) for m in meshes]
 solids = {}
 for k in range(n_panels):
     m = trimesh.load(f"{out}/panel-{k}.stl", force="mesh")

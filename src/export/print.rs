@@ -106,11 +106,48 @@ pub fn write_3mf(path: &Path, solids: &[Solid], scale: f64) -> Result<()> {
         unit: Unit::Millimeter,
         ..Default::default()
     };
-    let f = std::fs::File::create(path).map_err(|source| ExportError::Io {
+    let mut packed = std::io::Cursor::new(Vec::new());
+    threemf::write(&mut packed, model).map_err(|e| io_err(path, e))?;
+    let bytes = conventional_part_name(packed.into_inner()).map_err(|e| io_err(path, e))?;
+    std::fs::write(path, bytes).map_err(|source| ExportError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
-    threemf::write(std::io::BufWriter::new(f), model).map_err(|e| io_err(path, e))
+    })
+}
+
+/// The part name threemf writes, and the one the 3MF core specification's examples use and
+/// readers such as trimesh look for (slicers follow `_rels/.rels`, which names either).
+const PART_WRITTEN: &str = "3D/model.model";
+const PART_CONVENTIONAL: &str = "3D/3dmodel.model";
+
+/// Re-pack a 3MF archive with its model part at [`PART_CONVENTIONAL`] and the relationship
+/// pointing there; every other entry is copied unchanged.
+fn conventional_part_name(archive: Vec<u8>) -> std::result::Result<Vec<u8>, zip::result::ZipError> {
+    use std::io::{Read, Write};
+    let mut input = zip::ZipArchive::new(std::io::Cursor::new(archive))?;
+    let mut out = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let options = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    for k in 0..input.len() {
+        let mut entry = input.by_index(k)?;
+        let mut data = Vec::new();
+        entry.read_to_end(&mut data)?;
+        let name = entry.name()?.to_string();
+        let (name, data) = match name.as_str() {
+            PART_WRITTEN => (PART_CONVENTIONAL.to_string(), data),
+            "_rels/.rels" => {
+                let text = String::from_utf8_lossy(&data).replace(
+                    &format!("/{PART_WRITTEN}"),
+                    &format!("/{PART_CONVENTIONAL}"),
+                );
+                (name, text.into_bytes())
+            }
+            _ => (name, data),
+        };
+        out.start_file(name, options)?;
+        out.write_all(&data)?;
+    }
+    Ok(out.finish()?.into_inner())
 }
 
 /// A state of the motion to assemble: its name and the frame (`None`: the flat layout).
