@@ -72,11 +72,12 @@ pub struct ThickReport {
     pub states: usize,
     /// Pairs of panels tested at each state (apart and touching).
     pub pairs: usize,
-    /// The least distance between two apart panels over the sweep (paper units; ∞ when no
-    /// pair is apart).
-    pub least_apart: f64,
-    /// The least clearance of a panel from an obstacle (paper units; ∞ without obstacles).
-    pub least_obstacle: f64,
+    /// The least distance between two apart panels over the sweep (paper units; `None` when
+    /// no pair is apart, so nothing was measured: JSON has no infinity).
+    pub least_apart: Option<f64>,
+    /// The least clearance of a panel from an obstacle (paper units; `None` without
+    /// obstacles).
+    pub least_obstacle: Option<f64>,
     /// The clearance required between apart panels.
     pub clearance: f64,
     /// The clearance required from obstacles.
@@ -214,8 +215,8 @@ pub fn check(input: &ThickInput<'_>) -> ThickReport {
     let mut r = ThickReport {
         states: input.pattern.frames.len(),
         pairs: pairs.len(),
-        least_apart: f64::INFINITY,
-        least_obstacle: f64::INFINITY,
+        least_apart: None,
+        least_obstacle: None,
         clearance: input.clearance,
         obstacle_clearance: input.obstacle_clearance,
         crossings: 0,
@@ -237,11 +238,11 @@ pub fn check(input: &ThickInput<'_>) -> ThickReport {
             match rule {
                 Rule::Apart => {
                     // Spheres farther apart than the least so far cannot lower it.
-                    if apart >= r.least_apart {
+                    if r.least_apart.is_some_and(|least| apart >= least) {
                         continue;
                     }
                     let d = mesh_distance(a, b, -1.0);
-                    r.least_apart = r.least_apart.min(d);
+                    r.least_apart = Some(r.least_apart.map_or(d, |least| least.min(d)));
                     if d < input.clearance {
                         fail(&mut r, hit(frame.t, vec![i, j], "clearance", d, None));
                     }
@@ -260,7 +261,7 @@ pub fn check(input: &ThickInput<'_>) -> ThickReport {
                 let Some(c) = facet_clearance(&o.shape, &s.tris) else {
                     continue;
                 };
-                r.least_obstacle = r.least_obstacle.min(c);
+                r.least_obstacle = Some(r.least_obstacle.map_or(c, |least| least.min(c)));
                 if c < input.obstacle_clearance {
                     fail(
                         &mut r,
@@ -373,19 +374,13 @@ mod tests {
     fn stacked_slabs_are_their_facets_distance_less_the_reach_of_each() {
         // Upright: the slabs span [0, T] and [h, h + T]: h − T apart.
         let r = run(&stacked(0.1, false), 0.05);
-        assert!(
-            (r.least_apart - (0.1 - T)).abs() < 1e-12,
-            "{}",
-            r.least_apart
-        );
+        let least = r.least_apart.unwrap();
+        assert!((least - (0.1 - T)).abs() < 1e-12, "{least}");
         assert!(r.passes());
         // Turned over: [0, T] and [h − T, h]: h − 2T apart — the reduction's bound is tight.
         let r = run(&stacked(0.1, true), 0.05);
-        assert!(
-            (r.least_apart - (0.1 - 2.0 * T)).abs() < 1e-12,
-            "{}",
-            r.least_apart
-        );
+        let least = r.least_apart.unwrap();
+        assert!((least - (0.1 - 2.0 * T)).abs() < 1e-12, "{least}");
         assert!(r.passes());
         let r = run(&stacked(0.1, true), 0.07);
         let hit = r.first_failure.unwrap();
@@ -395,7 +390,18 @@ mod tests {
         );
         // Overlapping slabs are 0 apart, even when one surface lies inside the other.
         let r = run(&stacked(0.5 * T, false), 0.0);
-        assert_eq!(r.least_apart, 0.0);
+        assert_eq!(r.least_apart, Some(0.0));
+    }
+
+    #[test]
+    fn a_report_without_obstacles_reads_back_as_written() {
+        // JSON has no infinity: a distance never measured (no obstacle here) must not be
+        // written as a number the record reader then refuses (the robotic arm's records).
+        let r = run(&stacked(0.1, false), 0.05);
+        assert_eq!(r.least_obstacle, None);
+        let text = serde_json::to_string(&r).unwrap();
+        let back: ThickReport = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, r);
     }
 
     /// Two unit squares hinged along x = 1, the second folded by `rho` (valley > 0: toward
