@@ -600,8 +600,7 @@ pub fn report_html(out_dir: &Path, input: &ReportInput) -> Result<String> {
     } else {
         sm.title.clone()
     };
-    let mut data = designs_data(out_dir, input)?;
-    let scenes = scenes_data(input, &mut data)?;
+    let (data, scenes) = designs_data(out_dir, input)?;
     let mut s = format!(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{}</title><style>{CSS}</style></head><body>\n<header><h1>{}</h1><div>task: {}</div></header>\n<main>\n",
         xml_escape(&title),
@@ -640,17 +639,37 @@ pub fn report_html(out_dir: &Path, input: &ReportInput) -> Result<String> {
     let _ = write!(
         s,
         "<script type=\"application/json\" id=\"foldsynth-data\">{}</script>\n<script>{THREE_JS}</script>\n<script>{APP_JS}</script>\n</body></html>\n",
-        script_json(&json!({ "designs": data, "scenes": scenes }))
+        // `{"designs": […], "scenes": […]}`, as `json!` would write it (keys sorted).
+        format_args!(
+            "{{\"designs\":[{}],\"scenes\":{}}}",
+            data.join(","),
+            script_json(&json!(scenes))
+        )
     );
     Ok(s)
 }
 
-/// The distinct scenes of the designs (usually one: a task's), each once with its meshes;
-/// every design's data gets `scene`, the index of its own.
-fn scenes_data(input: &ReportInput, data: &mut [Value]) -> Result<Vec<Value>> {
+/// Every design's data for the page, as JSON text (its id unique and its metadata valid),
+/// and the distinct scenes of the designs (usually one: a task's), each once with its
+/// meshes; every design's data gets `scene`, the index of its own. Each design is turned
+/// into text as soon as it is built, so memory holds one design's JSON tree at a time, not
+/// every design's (the tree is several times its text: this was most of a large run's peak).
+fn designs_data(out_dir: &Path, input: &ReportInput) -> Result<(Vec<String>, Vec<Value>)> {
+    let mut data = Vec::with_capacity(input.designs.len());
+    let mut ids = BTreeSet::new();
     let mut seen: Vec<&DesignMeta> = Vec::new();
     let mut scenes = Vec::new();
-    for (d, v) in input.designs.iter().zip(data.iter_mut()) {
+    for (i, d) in input.designs.iter().enumerate() {
+        if !ids.insert(d.id.as_str()) {
+            return Err(ExportError::invalid(
+                format!("designs[{i}].id"),
+                format!("{:?} appears twice; design ids must be unique", d.id),
+            ));
+        }
+        let invalid =
+            |e: ExportError| ExportError::invalid(format!("design {}", d.id), e.to_string());
+        validate_meta(&d.meta, &d.pattern).map_err(invalid)?;
+        let mut v = design_json(out_dir, d).map_err(invalid)?;
         let m = &d.meta;
         let same = |o: &&DesignMeta| o.scene == m.scene && o.surfaces == m.surfaces;
         let k = match seen.iter().position(same) {
@@ -664,29 +683,9 @@ fn scenes_data(input: &ReportInput, data: &mut [Value]) -> Result<Vec<Value>> {
             }
         };
         v["scene"] = json!(k);
+        data.push(script_json(&v));
     }
-    Ok(scenes)
-}
-
-/// Every design's data for the page, its id unique and its metadata valid.
-fn designs_data(out_dir: &Path, input: &ReportInput) -> Result<Vec<Value>> {
-    let mut data = Vec::with_capacity(input.designs.len());
-    let mut ids = BTreeSet::new();
-    for (i, d) in input.designs.iter().enumerate() {
-        if !ids.insert(d.id.as_str()) {
-            return Err(ExportError::invalid(
-                format!("designs[{i}].id"),
-                format!("{:?} appears twice; design ids must be unique", d.id),
-            ));
-        }
-        validate_meta(&d.meta, &d.pattern)
-            .map_err(|e| ExportError::invalid(format!("design {}", d.id), e.to_string()))?;
-        data.push(
-            design_json(out_dir, d)
-                .map_err(|e| ExportError::invalid(format!("design {}", d.id), e.to_string()))?,
-        );
-    }
-    Ok(data)
+    Ok((data, scenes))
 }
 
 /// The summary section: counts against the thesis, stage timings, notes.
