@@ -120,6 +120,11 @@ fn written_files_read_back_as_built() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("thick check on the design's 9 frames: passes"),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
     // The same build here, for what the files must hold.
     let spec = Fabrication {
         thickness: 4.0,
@@ -169,6 +174,10 @@ fn written_files_read_back_as_built() {
     let bill: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("fabrication.json")).unwrap())
             .unwrap();
+    // Two panels across one crease, trimmed for its largest fold: they never cross.
+    assert_eq!(bill["check"]["states"], 9);
+    assert_eq!(bill["check"]["crossings"], 0);
+    assert!(bill["check"]["first_failure"].is_null());
     let crease = &bill["fabrication"]["creases"][0];
     // The bill's fold is the motion's: the sample folds its crease to 2 rad.
     assert!((crease["valley_deg"].as_f64().unwrap() - 2f64.to_degrees()).abs() < 1e-9);
@@ -298,4 +307,88 @@ fn bad_values_are_refused_naming_the_flag_or_the_crease() {
         err.contains("crease 0") && err.contains("design.json"),
         "{err}"
     );
+}
+
+/// Two unit squares apart in the flat layout (no crease between them); in the one folded
+/// frame the second lies flat over the first at height `h` (paper units).
+fn stacked_design(dir: &Path, h: f64) -> PathBuf {
+    use foldsynth::pattern::{Edge, EdgeKind, Frame, Pattern};
+    let sq = |x: f64| [[x, 0.0], [x + 1.0, 0.0], [x + 1.0, 1.0], [x, 1.0]];
+    let vertices: Vec<[f64; 2]> = sq(0.0).into_iter().chain(sq(3.0)).collect();
+    let mut coords: Vec<[f64; 3]> = sq(0.0).iter().map(|p| [p[0], p[1], 0.0]).collect();
+    coords.extend(sq(0.0).iter().map(|p| [p[0], p[1], h]));
+    let edges: Vec<Edge> = (0..8)
+        .map(|i| Edge {
+            v: [i, 4 * (i / 4) + (i + 1) % 4],
+            kind: EdgeKind::Boundary,
+        })
+        .collect();
+    let frame = |t: f64, coords: Vec<[f64; 3]>| Frame {
+        t,
+        coords,
+        fold_angles: vec![0.0; 8],
+    };
+    let flat = vertices.iter().map(|v| [v[0], v[1], 0.0]).collect();
+    let p = Pattern {
+        vertices,
+        edges,
+        faces: vec![vec![0, 1, 2, 3], vec![4, 5, 6, 7]],
+        frames: vec![frame(0.0, flat), frame(1.0, coords)],
+    };
+    let path = dir.join(format!("stacked-{h}.json"));
+    let text = serde_json::json!({"pattern": p, "meta": {"task": "fab-test"}});
+    std::fs::write(&path, text.to_string()).unwrap();
+    path
+}
+
+#[test]
+fn panels_that_collide_are_reported_naming_them() {
+    // 2 mm panels at 100 mm per unit on one side: each slab reaches 0.02 units above its
+    // facet, so a square 0.015 units over the other overlaps it, one 0.03 over it is 1 mm
+    // clear of it (3 mm less the 2 mm slab).
+    let dir = tempfile::tempdir().unwrap();
+    let fab = |h: f64, clearance: &str| {
+        let path = stacked_design(dir.path(), h);
+        let out = dir.path().join(format!("fab-{h}-{clearance}"));
+        let o = run(&[
+            "fabricate",
+            path.to_str().unwrap(),
+            "--thickness",
+            "2",
+            "--scale",
+            "100",
+            "--clearance",
+            clearance,
+            "--states",
+            "flat,folded",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        // No bill when the command refuses its flags.
+        let bill: serde_json::Value = std::fs::read_to_string(out.join("fabrication.json"))
+            .map_or(serde_json::Value::Null, |t| {
+                serde_json::from_str(&t).unwrap()
+            });
+        (o, bill)
+    };
+    let (o, bill) = fab(0.015, "0.5");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("collide") && err.contains("P0, P1") && err.contains("t = 1.0000"),
+        "{err}"
+    );
+    assert_eq!(bill["check"]["first_failure"]["kind"], "clearance");
+    assert_eq!(bill["check"]["least_apart"], 0.0);
+    // 1 mm apart: clear with the default 0.5 mm, not with 1.5 mm.
+    let (o, bill) = fab(0.03, "0.5");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let apart = bill["check"]["least_apart"].as_f64().unwrap();
+    assert!((apart - 0.01).abs() < 1e-12, "{apart}");
+    let (o, _) = fab(0.03, "1.5");
+    assert_eq!(o.status.code(), Some(1));
+    let (o, bill) = fab(0.03, "-1");
+    assert_eq!(o.status.code(), Some(2));
+    assert!(bill.is_null());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--clearance"));
 }

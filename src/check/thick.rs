@@ -7,7 +7,8 @@
 //! - two panels whose facets share no vertex (nor meet by design, see
 //!   [`ThickInput::touching`]) keep at least `clearance` apart: the least
 //!   triangle–triangle distance ([`super::distance::triangle_distance`]) of their closed
-//!   meshes, 0 when one contains the other (winding number of a corner);
+//!   meshes, 0 when one contains the other (winding number of a point just inside the
+//!   other);
 //! - two panels whose facets share a crease or a vertex, or meet by design, touch at most:
 //!   no two of their triangles cross ([`super::tri_tri::triangles_intersect`] with
 //!   [`TOUCH_TOL`]) and neither contains the other. Tapered panels of one crease meet at the
@@ -104,25 +105,48 @@ enum Rule {
     Touch,
 }
 
-/// One solid as triangles with its bounding sphere.
+/// One solid as triangles with its bounding sphere and a point inside it.
 struct Placed {
     tris: Vec<Tri>,
     centre: Vector3<f64>,
     radius: f64,
+    /// A point strictly inside: just behind the middle of its largest triangle. Not the
+    /// mean of its corners, which lies outside a non-convex panel (and there may lie inside
+    /// its neighbour, which made two panels that never meet "contain" each other).
+    inside: Vector3<f64>,
+}
+
+/// A point just inside a closed, outward-oriented mesh: the centroid of its largest
+/// triangle moved against that triangle's normal by a millionth of the mesh's size (far
+/// less than any panel's thickness).
+fn inside_point(tris: &[Tri], radius: f64) -> Vector3<f64> {
+    let normal = |t: &Tri| (t[1] - t[0]).cross(&(t[2] - t[0]));
+    let Some(big) = tris
+        .iter()
+        .max_by(|a, b| normal(a).norm().total_cmp(&normal(b).norm()))
+    else {
+        return Vector3::zeros();
+    };
+    let n = normal(big);
+    let centroid = (big[0] + big[1] + big[2]) / 3.0;
+    centroid - n * (1e-6 * radius / n.norm().max(f64::MIN_POSITIVE))
 }
 
 fn place(s: &Solid) -> Placed {
     let pts: Vec<Vector3<f64>> = s.vertices.iter().map(|p| Vector3::from(*p)).collect();
     let centre = pts.iter().sum::<Vector3<f64>>() / pts.len().max(1) as f64;
     let radius = pts.iter().map(|p| (p - centre).norm()).fold(0.0, f64::max);
+    let tris: Vec<Tri> = s
+        .triangles
+        .iter()
+        .map(|t| [pts[t[0]], pts[t[1]], pts[t[2]]])
+        .collect();
+    let inside = inside_point(&tris, radius);
     Placed {
-        tris: s
-            .triangles
-            .iter()
-            .map(|t| [pts[t[0]], pts[t[1]], pts[t[2]]])
-            .collect(),
+        tris,
         centre,
         radius,
+        inside,
     }
 }
 
@@ -141,10 +165,10 @@ fn winding(tris: &[Tri], p: &Vector3<f64>) -> f64 {
     total / (4.0 * std::f64::consts::PI)
 }
 
-/// Whether one of two solids holds the other's centroid: with surfaces that do not cross,
-/// one contains the other exactly then (the panels are convex, so the centroid is inside).
+/// Whether one of two solids holds a point inside the other: with surfaces that do not
+/// cross, one contains the other exactly then.
 fn contains(a: &Placed, b: &Placed) -> bool {
-    winding(&a.tris, &b.centre).abs() > 0.5 || winding(&b.tris, &a.centre).abs() > 0.5
+    winding(&a.tris, &b.inside).abs() > 0.5 || winding(&b.tris, &a.inside).abs() > 0.5
 }
 
 /// The least distance between two closed meshes, stopping early below `stop`; 0 when one
@@ -391,6 +415,58 @@ mod tests {
         // Overlapping slabs are 0 apart, even when one surface lies inside the other.
         let r = run(&stacked(0.5 * T, false), 0.0);
         assert_eq!(r.least_apart, Some(0.0));
+    }
+
+    #[test]
+    fn a_non_convex_panel_does_not_contain_what_lies_in_its_notch() {
+        // An L-shaped facet (arms 0.2 wide) and a square in its notch, 0.2 from both arms,
+        // flat: the mean of the L's corners, (0.733, 0.733), lies inside the square, yet
+        // the slabs are 0.2 apart and neither contains the other.
+        let l = [
+            [0.0, 0.0],
+            [2.0, 0.0],
+            [2.0, 0.2],
+            [0.2, 0.2],
+            [0.2, 2.0],
+            [0.0, 2.0],
+        ];
+        let sq = [[0.4, 0.4], [1.2, 0.4], [1.2, 1.2], [0.4, 1.2]];
+        let vertices: Vec<[f64; 2]> = l.iter().chain(&sq).copied().collect();
+        let coords = vertices.iter().map(|v| [v[0], v[1], 0.0]).collect();
+        let p = Pattern {
+            vertices,
+            edges: Vec::new(),
+            faces: vec![(0..6).collect(), (6..10).collect()],
+            frames: vec![Frame {
+                t: 0.0,
+                coords,
+                fold_angles: Vec::new(),
+            }],
+        };
+        let r = run(&p, 0.1);
+        let least = r.least_apart.unwrap();
+        assert!((least - 0.2).abs() < 1e-12, "{least}");
+        assert!(r.passes(), "{:?}", r.first_failure);
+        // The same two sharing a vertex (the square grown to the L's inner corner) touch
+        // there and do not cross.
+        let mut p = p;
+        p.vertices[6] = [0.2, 0.2];
+        p.frames[0].coords[6] = [0.2, 0.2, 0.0];
+        p.faces[1] = vec![3, 7, 8, 9];
+        let r = check(&ThickInput {
+            pattern: &p,
+            design: &slabs(&p),
+            clearance: 0.1,
+            obstacle_clearance: 0.0,
+            obstacles: &[],
+            touching: &[],
+        });
+        assert_eq!(
+            (r.crossings, r.passes()),
+            (0, true),
+            "{:?}",
+            r.first_failure
+        );
     }
 
     #[test]

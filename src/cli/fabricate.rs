@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 
+use crate::check::thick::ThickInput;
 use crate::export::{DesignFile, laser, print};
 use crate::fabricate;
 use crate::task::fabrication::{
@@ -35,6 +36,10 @@ pub struct FabricateArgs {
     /// Narrowest a trimmed panel may become, mm.
     #[arg(long, default_value_t = DEFAULT_MIN_WIDTH_MM, allow_hyphen_values = true)]
     pub min_width: f64,
+    /// The least gap, mm, between two panels that share no vertex, checked on every frame
+    /// of the design (panels that share a crease or a vertex must not cross).
+    #[arg(long, default_value_t = DEFAULT_CLEARANCE_MM, allow_hyphen_values = true)]
+    pub clearance: f64,
     /// States to assemble, comma-separated: flat, half (the frame nearest the middle of
     /// the motion's t), folded (the last frame).
     #[arg(long, default_value = "flat,half,folded")]
@@ -43,6 +48,9 @@ pub struct FabricateArgs {
     #[arg(long)]
     pub out: PathBuf,
 }
+
+/// `--clearance`'s default, mm: half a millimetre between panels that pass each other.
+pub const DEFAULT_CLEARANCE_MM: f64 = 0.5;
 
 /// The setting from the flags; errors name the flag.
 fn setting(a: &FabricateArgs) -> anyhow::Result<Fabrication> {
@@ -70,6 +78,12 @@ fn setting(a: &FabricateArgs) -> anyhow::Result<Fabrication> {
     };
     if let Err((field, message)) = spec.validate() {
         bail!("--{}: {message}", field.replace('_', "-"));
+    }
+    if !(a.clearance.is_finite() && (0.0..=10_000.0).contains(&a.clearance)) {
+        bail!(
+            "--clearance: must be a number of mm in [0, 10000], got {}",
+            crate::text::num(a.clearance)
+        );
     }
     Ok(spec)
 }
@@ -129,11 +143,23 @@ pub fn run(a: FabricateArgs) -> anyhow::Result<()> {
         .collect();
     files.extend(print::write_solids(&a.out, pattern, &design, &st)?);
     let bill = design.bill();
+    // Whether the thick panels still fold without collision: the actual solids, moved by
+    // the design's frames (the search checks its dense sweep; a design file holds its
+    // frames only), tested by the search's independent mesh check.
+    let check = crate::check::thick::check(&ThickInput {
+        pattern,
+        design: &design,
+        clearance: a.clearance / spec.scale,
+        obstacle_clearance: 0.0,
+        obstacles: &[],
+        touching: &[],
+    });
     let json = a.out.join("fabrication.json");
     let text = serde_json::to_string_pretty(&serde_json::json!({
         "design": a.design.display().to_string(),
         "states": wanted.iter().map(|(n, f)| serde_json::json!({"name": n, "frame": f})).collect::<Vec<_>>(),
         "fabrication": bill,
+        "check": check,
     }))?;
     std::fs::write(&json, text + "\n").with_context(|| format!("{}", json.display()))?;
     files.push(json);
@@ -149,5 +175,35 @@ pub fn run(a: FabricateArgs) -> anyhow::Result<()> {
     for f in files {
         println!("wrote {}", f.display());
     }
-    Ok(())
+    let mm = |d: Option<f64>| d.map_or("–".to_string(), |d| format!("{:.3} mm", d * spec.scale));
+    match &check.first_failure {
+        None => {
+            println!(
+                "thick check on the design's {} frames: passes (least gap between panels that share no vertex {}, clearance {} mm)",
+                check.states,
+                mm(check.least_apart),
+                crate::text::num(a.clearance)
+            );
+            Ok(())
+        }
+        Some(hit) => Err(super::CheckFailed(format!(
+            "{}: the thick panels collide: {} (panels {}) at t = {:.4}; the files are written, and fabrication.json holds the check",
+            a.design.display(),
+            match hit.kind.as_str() {
+                "crossing" => "panels that share a crease or a vertex cross".to_string(),
+                _ => format!(
+                    "{} apart, below --clearance {} mm",
+                    mm(Some(hit.distance)),
+                    crate::text::num(a.clearance)
+                ),
+            },
+            hit.facets
+                .iter()
+                .map(|f| format!("P{f}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            hit.t
+        ))
+        .into()),
+    }
 }
