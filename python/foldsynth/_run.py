@@ -76,6 +76,21 @@ def _progress_callback(progress: Union[bool, Callable[[ProgressEvent], Any], Non
     return (lambda *step: bar(ProgressEvent(*step))), bar
 
 
+def _export_count(export: Union[bool, int, str]):
+    """``export`` as the native search takes it: (write files, how many most robust
+    designs get every file (``None``: the default), every design gets every file)."""
+    if export is True or export is False:
+        return export, None, False
+    if isinstance(export, numbers.Integral) and export >= 0:
+        return True, int(export), False
+    if isinstance(export, str) and export.strip().lower() == "all":
+        return True, None, True
+    raise ValueError(
+        f"export={export!r}: True (the 20 most robust designs' files), False (none), "
+        "a number of designs (the most robust) or 'all'"
+    )
+
+
 def synthesize(
     task: Union[_native.Task, PathLike],
     *,
@@ -87,7 +102,8 @@ def synthesize(
     sweep: int = 181,
     resume: bool = False,
     force: bool = False,
-    export: bool = True,
+    export: Union[bool, int, str] = True,
+    shard: Optional[str] = None,
     rules: str = "r1,r2",
     post_check_only: bool = False,
     progress: Union[bool, Callable[[ProgressEvent], Any]] = True,
@@ -99,8 +115,12 @@ def synthesize(
     (worker threads, 0 = one per core), ``starts`` and ``seed`` (the optimizer's starting
     points), ``sweep`` (states of the verification sweep), ``resume`` (keep the records
     of an earlier run of the same settings and evaluate only the rest), ``force`` (use a
-    directory holding something else), ``export`` (``False`` = ``--no-export``), ``rules``
-    (``"r1,r2"`` or ``"r1,r2,r2p"``), ``post_check_only``.
+    directory holding something else), ``export`` (``--export``: ``True`` writes every
+    design's FOLD file and the other files of the 20 most robust, a number ``N`` those of
+    the ``N`` most robust, ``"all"`` every design's, ``False`` = ``--no-export``),
+    ``shard`` (``--shard``: ``"K/N"`` runs only shard K of N into ``out``, records only;
+    ``foldsynth merge`` joins the shards, ``Run.open`` reads each), ``rules`` (``"r1,r2"``
+    or ``"r1,r2,r2p"``), ``post_check_only``.
 
     The search runs natively with the GIL released. ``progress``: ``True`` shows a tqdm bar
     per phase where tqdm is installed (nothing otherwise), ``False`` nothing, a callable is
@@ -110,6 +130,7 @@ def synthesize(
     """
     if not isinstance(task, _native.Task):
         task = _native.Task.load(os.fspath(task))
+    on, top, every = _export_count(export)
     callback, bar = _progress_callback(progress)
     try:
         _native.synthesize(
@@ -122,7 +143,10 @@ def synthesize(
             force=force,
             n_max=n_max,
             sweep=sweep,
-            export=export,
+            export=on,
+            export_top=top,
+            export_all=every,
+            shard=shard,
             rules=rules,
             post_check_only=post_check_only,
             callback=callback,

@@ -4,9 +4,11 @@
 //! the FOLD document of a design file.
 
 use super::{FoldsynthError, Task, fs_err};
+use foldsynth::distribute;
 use foldsynth::export::{DesignFile, FoldSpec, fold};
 use foldsynth::grammar::Rules;
-use foldsynth::search::{self, ProgressHook, SearchOptions};
+use foldsynth::search::output::ShardSpec;
+use foldsynth::search::{self, ProgressHook, SearchOptions, ShardReport, Summary};
 use foldsynth::task::Task as FsTask;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -55,16 +57,24 @@ fn hook(steps: &Steps) -> ProgressHook {
     })
 }
 
-/// Run the search of `task` with `opts` off the GIL; progress goes to `callback`
+/// What the search thread ran: the whole search, or one shard of it (`shard="K/N"`).
+enum Outcome {
+    Whole(Box<Summary>),
+    Shard(ShardReport),
+}
+
+/// Run the search of `task` with `opts` off the GIL (only `shard` of it, if given, with
+/// the task file's text for the merge); progress goes to `callback`
 /// (`callback(phase, unit, done, total, finished)`) on the calling thread. An exception
 /// from the callback or a signal (Ctrl-C: KeyboardInterrupt) stops the search — no new
 /// alternative is started, those in flight are written — and is raised once it has
 /// stopped, so the directory holds a run that `resume=True` continues. Returns the
-/// summary as a Python object (summary.json's content).
+/// summary as a Python object (summary.json's content; a shard's: shard.json's).
 pub fn search<'py>(
     py: Python<'py>,
     task: &Arc<FsTask>,
     mut opts: SearchOptions,
+    shard: Option<(ShardSpec, String)>,
     callback: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     if opts.starts == 0 {
@@ -81,7 +91,14 @@ pub fn search<'py>(
     let worker = std::thread::Builder::new()
         .name("foldsynth-search".into())
         .spawn(move || {
-            let result = search::run(&task, &opts);
+            let result = match &shard {
+                None => search::run(&task, &opts)
+                    .map(|s| Outcome::Whole(Box::new(s)))
+                    .map_err(anyhow::Error::from),
+                Some((spec, text)) => distribute::shard::run(&task, text, &opts, *spec)
+                    .map(Outcome::Shard)
+                    .map_err(anyhow::Error::from),
+            };
             // The receiver may be gone only if the caller panicked: nothing to tell.
             let _ = tx.send(());
             result
@@ -118,17 +135,23 @@ pub fn search<'py>(
             break;
         }
     }
-    let summary = py
+    let outcome = py
         .detach(|| worker.join())
         .map_err(|_| FoldsynthError::new_err("the search thread panicked (a bug in foldsynth)"))?
         .map_err(fs_err)?;
-    if summary.verification_failures > 0 {
-        return Err(FoldsynthError::new_err(format!(
-            "{} designs failed verification (a bug; see the messages on stderr)",
-            summary.verification_failures
-        )));
+    let text = match outcome {
+        Outcome::Whole(summary) => {
+            if summary.verification_failures > 0 {
+                return Err(FoldsynthError::new_err(format!(
+                    "{} designs failed verification (a bug; see the messages on stderr)",
+                    summary.verification_failures
+                )));
+            }
+            serde_json::to_string(&summary)
+        }
+        Outcome::Shard(report) => serde_json::to_string(&report),
     }
-    let text = serde_json::to_string(&summary).map_err(fs_err)?;
+    .map_err(fs_err)?;
     py.import("json")?.call_method1("loads", (text,))
 }
 
@@ -136,7 +159,7 @@ pub fn search<'py>(
 /// `callback(phase, unit, done, total, finished)` with its progress; returns the summary.
 /// `foldsynth.synthesize` wraps it and returns a `Run`.
 #[pyfunction]
-#[pyo3(signature = (task, out, *, jobs = 0, starts = 16, seed = 0, resume = false, force = false, n_max = None, sweep = 181, export = true, rules = "r1,r2", post_check_only = false, callback = None))]
+#[pyo3(signature = (task, out, *, jobs = 0, starts = 16, seed = 0, resume = false, force = false, n_max = None, sweep = 181, export = true, export_top = None, export_all = false, shard = None, rules = "r1,r2", post_check_only = false, callback = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn synthesize<'py>(
     py: Python<'py>,
@@ -150,12 +173,32 @@ pub fn synthesize<'py>(
     n_max: Option<usize>,
     sweep: usize,
     export: bool,
+    export_top: Option<usize>,
+    export_all: bool,
+    shard: Option<&str>,
     rules: &str,
     post_check_only: bool,
     callback: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let rules =
         Rules::parse(rules).map_err(|e| PyValueError::new_err(format!("rules {rules:?}: {e}")))?;
+    let shard = match shard {
+        None => None,
+        Some(text) => {
+            let spec: ShardSpec = text
+                .parse()
+                .map_err(|e| PyValueError::new_err(format!("shard: {e}")))?;
+            // The merge rebuilds the designs from the task's text, kept with the shard.
+            let Some(source) = task.task.source.as_deref() else {
+                return Err(PyValueError::new_err(
+                    "shard: a shard keeps its task file for the merge; give the task as a file (or a Task loaded from one)",
+                ));
+            };
+            let text = std::fs::read_to_string(source)
+                .map_err(|e| FoldsynthError::new_err(format!("{}: {e}", source.display())))?;
+            Some((spec, text))
+        }
+    };
     let opts = SearchOptions {
         out,
         jobs,
@@ -166,12 +209,18 @@ pub fn synthesize<'py>(
         n_max,
         sweep,
         export,
+        // `export=N`: the N most robust; `"all"`: every design; `True`: the CLI's default.
+        export_top: if export_all {
+            None
+        } else {
+            Some(export_top.unwrap_or(search::EXPORT_TOP))
+        },
         progress: false,
         rules,
         post_check_only,
         ..SearchOptions::default()
     };
-    search(py, &task.task, opts, callback)
+    search(py, &task.task, opts, shard, callback)
 }
 
 /// The FOLD 1.2 document (JSON text) of the design file `path` (`designs/<id>.json`), as

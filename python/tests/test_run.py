@@ -198,11 +198,19 @@ def test_open_reads_a_run_merged_from_shards(run, cli, tmp_path):
     shards = []
     for k in (1, 2):
         d = tmp_path / f"shard{k}"
-        subprocess.run(
-            [str(cli), "synthesize", task_file, "--shard", f"{k}/2", "--out", str(d)] + common,
-            check=True,
-            capture_output=True,
-        )
+        if k == 1:
+            # One shard from Python, one from the CLI: the same kind of directory.
+            foldsynth.synthesize(
+                task_file, out=d, shard="1/2", n_max=N_MAX, starts=STARTS, export=False,
+                progress=False,
+            )
+        else:
+            subprocess.run(
+                [str(cli), "synthesize", task_file, "--shard", f"{k}/2", "--out", str(d)]
+                + common,
+                check=True,
+                capture_output=True,
+            )
         shard = foldsynth.Run.open(d)
         assert not shard.finished
         with pytest.raises(foldsynth.FoldsynthError, match="shard"):
@@ -220,7 +228,24 @@ def test_open_reads_a_run_merged_from_shards(run, cli, tmp_path):
     assert m.design(1).objective == run.design(1).objective
 
 
+def test_export_counts_as_the_cli(run, task, tmp_path):
+    # export=N: every design gets its FOLD file, the N most robust every file (as --export N).
+    r = foldsynth.synthesize(
+        task, out=tmp_path / "three", n_max=N_MAX, starts=STARTS, export=3, progress=False
+    )
+    ids = list(r.designs()["id"])
+    assert ids == list(run.designs()["id"]) and len(ids) > 3
+    files = {i: sorted(p.name for p in (tmp_path / "three" / "designs" / i).iterdir()) for i in ids}
+    assert all(len(files[i]) > 1 for i in ids[:3])
+    assert all(files[i] == [f"{i}.fold"] for i in ids[3:])
+
+
 def test_synthesize_rejects_bad_settings(task, tmp_path):
+    for bad in (-1, 2.5, "some"):
+        with pytest.raises(ValueError, match="export"):
+            foldsynth.synthesize(task, out=tmp_path / "e", export=bad, progress=False)
+    with pytest.raises(ValueError, match="shard"):
+        foldsynth.synthesize(task, out=tmp_path / "s", shard="3/2", progress=False)
     with pytest.raises(ValueError, match="starts"):
         foldsynth.synthesize(task, out=tmp_path / "a", starts=0, progress=False)
     with pytest.raises(ValueError, match="rules"):
