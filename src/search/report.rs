@@ -315,11 +315,24 @@ pub(super) fn report_design(
     if let Ok(sc) = crate::export::svg::svg_scale(&pattern, &Default::default()) {
         facts.push(Fact::new("crease-pattern SVG", sc.note));
     }
+    // The page's geometry now, and the frames dropped: the cards of every design wait in
+    // memory for the report (the text is about a fifth of the frames' memory). A pattern
+    // the page cannot draw keeps its frames, and the report says why.
+    let geometry = crate::export::report::geometry_text(&pattern).ok();
+    let pattern = if geometry.is_some() {
+        Pattern {
+            frames: Vec::new(),
+            ..pattern
+        }
+    } else {
+        pattern
+    };
     ReportDesign {
         id: rec.id(),
         level: rec.level,
         candidate: Some(rec.candidate),
         pattern,
+        geometry,
         meta,
         robustness: robustness(rec),
         area: rec

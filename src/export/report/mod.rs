@@ -26,6 +26,7 @@ pub use thick_view::thick_json;
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -34,7 +35,7 @@ use serde_json::{Value, json};
 use super::fold::assignments;
 use super::plots::{DistributionPlot, TreeNode, distribution_svg, search_tree_svg, xml_escape};
 use super::verify::VerifyReport;
-use super::{DesignMeta, ExportError, Files, Result, validate_meta, validate_pattern, write_file};
+use super::{DesignMeta, ExportError, Files, Result, validate_meta, validate_pattern};
 use crate::check::triangulate::triangulate_faces;
 use crate::pattern::{EdgeKind, Pattern};
 
@@ -111,8 +112,13 @@ pub struct ReportDesign {
     /// Gripping candidate (1, 2, 3), if the task has candidates.
     pub candidate: Option<usize>,
     /// The crease pattern and its folded frames: the 3D view and the crease pattern are
-    /// drawn from this.
+    /// drawn from this (its frames may be dropped when `geometry` is given).
     pub pattern: Pattern,
+    /// The page's geometry of the design as [`geometry_text`] makes it, when the caller
+    /// made it beforehand and dropped the frames from `pattern` (a search holds every
+    /// design until the report is written: the text is a fifth of the frames' memory);
+    /// `None`: made from `pattern`.
+    pub geometry: Option<String>,
     /// Rule sequence, modes, gripping vertex, objective, targets, trajectory, obstacle,
     /// second arm.
     pub meta: DesignMeta,
@@ -231,6 +237,11 @@ pub fn geometry_json(p: &Pattern) -> Result<Value> {
     }))
 }
 
+/// [`geometry_json`] as the text the page embeds.
+pub fn geometry_text(p: &Pattern) -> Result<String> {
+    Ok(script_json(&geometry_json(p)?))
+}
+
 /// One margin `{value, setting, t, where}` of a robustness record, if present.
 fn margin<'a>(rob: Option<&'a Value>, key: &str) -> Option<&'a Value> {
     rob?.get(key)
@@ -271,7 +282,7 @@ fn modes_text(m: &DesignMeta) -> String {
         .join(", ")
 }
 
-/// The per-design data the page's script reads.
+/// The per-design data the page's script reads, but for its geometry ([`design_text`]).
 fn design_json(out_dir: &Path, d: &ReportDesign) -> Result<Value> {
     let m = &d.meta;
     let mut files: Vec<(String, String)> = Vec::new();
@@ -349,7 +360,6 @@ fn design_json(out_dir: &Path, d: &ReportDesign) -> Result<Value> {
         "robustness": d.robustness,
         "facts": facts,
         "files": files,
-        "geometry": geometry_json(&d.pattern)?,
         "targets": m.targets.iter().map(|t| [r4(t.p[0]), r4(t.p[1]), r4(t.p[2])]).collect::<Vec<_>>(),
         "trajectory": m.trajectory.iter().map(|q| [r4(q[0]), r4(q[1]), r4(q[2])]).collect::<Vec<_>>(),
         "goals": scene_data::goals_json(m),
@@ -594,13 +604,33 @@ fn script_json(v: &Value) -> String {
 
 /// The report page as HTML text; links are relative to `out_dir`.
 pub fn report_html(out_dir: &Path, input: &ReportInput) -> Result<String> {
+    let mut page = Vec::new();
+    let scenes = designs_scenes(input)?;
+    write_html(&mut page, out_dir, input, &scenes, Path::new("report.html"))?;
+    // Only `str`s were written.
+    Ok(String::from_utf8(page).unwrap_or_default())
+}
+
+/// Write the report page to `w` piece by piece: a large run's page is hundreds of MB, and
+/// it is never held whole in memory (`scenes`: [`designs_scenes`] of `input`; `path`: what
+/// to name in an I/O error).
+fn write_html(
+    w: &mut impl std::io::Write,
+    out_dir: &Path,
+    input: &ReportInput,
+    (scene_of, scenes): &(Vec<usize>, Vec<Value>),
+    path: &Path,
+) -> Result<()> {
+    let io = |source: std::io::Error| ExportError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
     let sm = &input.summary;
     let title = if sm.title.is_empty() {
         "foldsynth report".to_string()
     } else {
         sm.title.clone()
     };
-    let (data, scenes) = designs_data(out_dir, input)?;
     let mut s = format!(
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><meta name=\"viewport\" content=\"width=device-width, initial-scale=1\"><title>{}</title><style>{CSS}</style></head><body>\n<header><h1>{}</h1><div>task: {}</div></header>\n<main>\n",
         xml_escape(&title),
@@ -620,7 +650,10 @@ pub fn report_html(out_dir: &Path, input: &ReportInput) -> Result<String> {
         s += "</tbody></table></section>\n";
     }
     s += &summary_section(sm);
-    s += &designs_section(&input.designs);
+    w.write_all(s.as_bytes()).map_err(io)?;
+    w.write_all(designs_section(&input.designs).as_bytes())
+        .map_err(io)?;
+    let mut s = String::new();
     if !input.tree.is_empty() {
         let _ = writeln!(
             s,
@@ -635,30 +668,31 @@ pub fn report_html(out_dir: &Path, input: &ReportInput) -> Result<String> {
             distribution_svg(d)?
         );
     }
-    s += "</main>\n";
-    let _ = write!(
-        s,
-        "<script type=\"application/json\" id=\"foldsynth-data\">{}</script>\n<script>{THREE_JS}</script>\n<script>{APP_JS}</script>\n</body></html>\n",
-        // `{"designs": […], "scenes": […]}`, as `json!` would write it (keys sorted).
-        format_args!(
-            "{{\"designs\":[{}],\"scenes\":{}}}",
-            data.join(","),
-            script_json(&json!(scenes))
-        )
-    );
-    Ok(s)
+    // `{"designs": […], "scenes": […]}`, one design at a time.
+    s += "</main>\n<script type=\"application/json\" id=\"foldsynth-data\">{\"designs\":[";
+    w.write_all(s.as_bytes()).map_err(io)?;
+    for (i, (d, &scene)) in input.designs.iter().zip(scene_of).enumerate() {
+        if i > 0 {
+            w.write_all(b",").map_err(io)?;
+        }
+        w.write_all(design_text(out_dir, d, scene)?.as_bytes())
+            .map_err(io)?;
+    }
+    write!(
+        w,
+        "],\"scenes\":{}}}</script>\n<script>{THREE_JS}</script>\n<script>{APP_JS}</script>\n</body></html>\n",
+        script_json(&json!(scenes))
+    )
+    .map_err(io)
 }
 
-/// Every design's data for the page, as JSON text (its id unique and its metadata valid),
-/// and the distinct scenes of the designs (usually one: a task's), each once with its
-/// meshes; every design's data gets `scene`, the index of its own. Each design is turned
-/// into text as soon as it is built, so memory holds one design's JSON tree at a time, not
-/// every design's (the tree is several times its text: this was most of a large run's peak).
-fn designs_data(out_dir: &Path, input: &ReportInput) -> Result<(Vec<String>, Vec<Value>)> {
-    let mut data = Vec::with_capacity(input.designs.len());
+/// Every design's id unique and its metadata valid; the distinct scenes of the designs
+/// (usually one: a task's), each once with its meshes, and the index of each design's own.
+fn designs_scenes(input: &ReportInput) -> Result<(Vec<usize>, Vec<Value>)> {
     let mut ids = BTreeSet::new();
     let mut seen: Vec<&DesignMeta> = Vec::new();
     let mut scenes = Vec::new();
+    let mut index = Vec::with_capacity(input.designs.len());
     for (i, d) in input.designs.iter().enumerate() {
         if !ids.insert(d.id.as_str()) {
             return Err(ExportError::invalid(
@@ -669,23 +703,38 @@ fn designs_data(out_dir: &Path, input: &ReportInput) -> Result<(Vec<String>, Vec
         let invalid =
             |e: ExportError| ExportError::invalid(format!("design {}", d.id), e.to_string());
         validate_meta(&d.meta, &d.pattern).map_err(invalid)?;
-        let mut v = design_json(out_dir, d).map_err(invalid)?;
         let m = &d.meta;
         let same = |o: &&DesignMeta| o.scene == m.scene && o.surfaces == m.surfaces;
         let k = match seen.iter().position(same) {
             Some(k) => k,
             None => {
-                scenes.push(scene_data::scene_json(m).map_err(|e| {
-                    ExportError::invalid(format!("design {}", d.id), e.to_string())
-                })?);
+                scenes.push(scene_data::scene_json(m).map_err(invalid)?);
                 seen.push(m);
                 seen.len() - 1
             }
         };
-        v["scene"] = json!(k);
-        data.push(script_json(&v));
+        index.push(k);
     }
-    Ok((data, scenes))
+    Ok((index, scenes))
+}
+
+/// One design's data for the page as JSON text: [`design_json`] with `scene` (the index of
+/// its scene) and `geometry`. Each design becomes text as soon as it is built, so memory
+/// holds one design's JSON tree at a time.
+fn design_text(out_dir: &Path, d: &ReportDesign, scene: usize) -> Result<String> {
+    let invalid = |e: ExportError| ExportError::invalid(format!("design {}", d.id), e.to_string());
+    let mut v = design_json(out_dir, d).map_err(invalid)?;
+    v["scene"] = json!(scene);
+    let mut text = script_json(&v);
+    // `text` is an object: close it with the geometry, made beforehand or now.
+    text.pop();
+    text.push_str(",\"geometry\":");
+    match &d.geometry {
+        Some(g) => text.push_str(g),
+        None => text.push_str(&geometry_text(&d.pattern).map_err(invalid)?),
+    }
+    text.push('}');
+    Ok(text)
 }
 
 /// The summary section: counts against the thesis, stage timings, notes.
@@ -757,9 +806,28 @@ black dot and line: the gripping vertex and its path; green: targets, trajectory
 
 /// Write `out_dir/report.html` and return its path.
 pub fn write_report(out_dir: &Path, input: &ReportInput) -> Result<PathBuf> {
-    let html = report_html(out_dir, input)?;
     let path = out_dir.join("report.html");
-    write_file(&path, html)?;
+    // Judged before the file is touched: a report that cannot be made leaves an earlier
+    // one in place (its design ids, metadata and scenes; a design's link to a missing file
+    // is found only while writing, and then no half page is left).
+    let scenes = designs_scenes(input)?;
+    let file = std::fs::File::create(&path).map_err(|source| ExportError::Io {
+        path: path.clone(),
+        source,
+    })?;
+    let mut w = std::io::BufWriter::new(file);
+    let written = write_html(&mut w, out_dir, input, &scenes, &path).and_then(|()| {
+        w.flush().map_err(|source| ExportError::Io {
+            path: path.clone(),
+            source,
+        })
+    });
+    if let Err(e) = written {
+        // No half page: a report that cannot be made is not there.
+        drop(w);
+        let _ = std::fs::remove_file(&path);
+        return Err(e);
+    }
     Ok(path)
 }
 
