@@ -453,14 +453,7 @@ mod tests {
         p.vertices[6] = [0.2, 0.2];
         p.frames[0].coords[6] = [0.2, 0.2, 0.0];
         p.faces[1] = vec![3, 7, 8, 9];
-        let r = check(&ThickInput {
-            pattern: &p,
-            design: &slabs(&p),
-            clearance: 0.1,
-            obstacle_clearance: 0.0,
-            obstacles: &[],
-            touching: &[],
-        });
+        let r = run(&p, 0.1);
         assert_eq!(
             (r.crossings, r.passes()),
             (0, true),

@@ -10,7 +10,7 @@ use crate::check::thick::ThickInput;
 use crate::export::{DesignFile, laser, print};
 use crate::fabricate;
 use crate::task::fabrication::{
-    DEFAULT_HINGE_GAP_MM, DEFAULT_MIN_WIDTH_MM, FabMethod, Fabrication, Sides,
+    DEFAULT_HINGE_GAP_MM, DEFAULT_MIN_WIDTH_MM, FabMethod, Fabrication, MAX_LENGTH_MM, Sides,
 };
 
 /// Arguments of `foldsynth fabricate`.
@@ -79,9 +79,10 @@ fn setting(a: &FabricateArgs) -> anyhow::Result<Fabrication> {
     if let Err((field, message)) = spec.validate() {
         bail!("--{}: {message}", field.replace('_', "-"));
     }
-    if !(a.clearance.is_finite() && (0.0..=10_000.0).contains(&a.clearance)) {
+    if !(a.clearance.is_finite() && (0.0..=MAX_LENGTH_MM).contains(&a.clearance)) {
         bail!(
-            "--clearance: must be a number of mm in [0, 10000], got {}",
+            "--clearance: must be a number of mm in [0, {}], got {}",
+            crate::text::num(MAX_LENGTH_MM),
             crate::text::num(a.clearance)
         );
     }

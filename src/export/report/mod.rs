@@ -26,7 +26,6 @@ pub use thick_view::thick_json;
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -683,6 +682,7 @@ fn write_html(
         "],\"scenes\":{}}}</script>\n<script>{THREE_JS}</script>\n<script>{APP_JS}</script>\n</body></html>\n",
         script_json(&json!(scenes))
     )
+    .and_then(|()| w.flush())
     .map_err(io)
 }
 
@@ -816,13 +816,7 @@ pub fn write_report(out_dir: &Path, input: &ReportInput) -> Result<PathBuf> {
         source,
     })?;
     let mut w = std::io::BufWriter::new(file);
-    let written = write_html(&mut w, out_dir, input, &scenes, &path).and_then(|()| {
-        w.flush().map_err(|source| ExportError::Io {
-            path: path.clone(),
-            source,
-        })
-    });
-    if let Err(e) = written {
+    if let Err(e) = write_html(&mut w, out_dir, input, &scenes, &path) {
         // No half page: a report that cannot be made is not there.
         drop(w);
         let _ = std::fs::remove_file(&path);
