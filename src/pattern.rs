@@ -35,7 +35,9 @@ pub struct Frame {
     pub t: f64,
     /// 3D position of every vertex.
     pub coords: Vec<[f64; 3]>,
-    /// Fold angle of every edge in radians, valley positive (0 for boundary edges).
+    /// Fold angle of every edge in radians, valley positive (0 for boundary edges). A
+    /// design file may leave it out (read as empty; see `export::motion`).
+    #[serde(default)]
     pub fold_angles: Vec<f64>,
 }
 
@@ -56,5 +58,16 @@ impl Pattern {
     /// The flat state lifted to 3D (z = 0).
     pub fn flat_coords(&self) -> Vec<[f64; 3]> {
         self.vertices.iter().map(|p| [p[0], p[1], 0.0]).collect()
+    }
+
+    /// The crease pattern with its folded form alone: the last frame, the state a FOLD
+    /// viewer folds toward (no frame when there is none).
+    pub fn folded_form(&self) -> Pattern {
+        Pattern {
+            vertices: self.vertices.clone(),
+            edges: self.edges.clone(),
+            faces: self.faces.clone(),
+            frames: self.frames.last().cloned().into_iter().collect(),
+        }
     }
 }

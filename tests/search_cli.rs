@@ -125,16 +125,29 @@ fn exported_designs_verify_and_the_report_exists() {
         assert!(design["objective"].as_f64().unwrap() <= 1e-5);
         assert_eq!(design["verification"]["rigid_over_motion"], true);
         assert!(design["verification"]["isometry_max"].as_f64().unwrap() <= 1e-9);
-        let fold = out.join("designs").join(id).join(format!("{id}.fold"));
-        let r = foldsynth(&["verify", fold.to_str().unwrap()]);
-        assert!(
-            r.status.success(),
-            "{id}: {}",
-            String::from_utf8_lossy(&r.stdout)
-        );
-        // The FOLD file, simulated by the bar-and-hinge model from its own frames, folds
-        // rigidly onto the PTU's states.
-        let r = foldsynth(&["simulate", fold.to_str().unwrap(), "--json"]);
+        // Every design's FOLD file (crease pattern, folded form) and, for the 20 most
+        // robust, the one with the whole motion verify.
+        let folded = out.join("designs").join(format!("{id}.fold"));
+        let full = out.join("designs").join(id).join(format!("{id}.fold"));
+        let rank = design["rank"].as_u64().unwrap();
+        assert_eq!(full.exists(), rank <= 20, "{id}: rank {rank}");
+        for fold in [&folded, &full].into_iter().filter(|f| f.exists()) {
+            let r = foldsynth(&["verify", fold.to_str().unwrap()]);
+            assert!(
+                r.status.success(),
+                "{id}: {}",
+                String::from_utf8_lossy(&r.stdout)
+            );
+        }
+        // The motion (the FOLD file's frames, or the design JSON's, whose fold angles are
+        // read from its positions), simulated by the bar-and-hinge model, folds rigidly
+        // onto the PTU's states.
+        let moving = if full.exists() {
+            full
+        } else {
+            out.join("designs").join(format!("{id}.json"))
+        };
+        let r = foldsynth(&["simulate", moving.to_str().unwrap(), "--json"]);
         assert!(
             r.status.success(),
             "{id}: {}",
@@ -212,4 +225,77 @@ fn bad_task_files_are_clear_errors() {
         );
         assert!(!err.contains("panicked"), "{name}: {err}");
     }
+}
+
+/// `--report-motions N`: the report draws the whole motion (33 frames) of the N most
+/// robust designs and, for the others, the folded form alone: the design's last frame, as
+/// its JSON has it (the page rounds to 1e-4).
+#[test]
+fn the_report_draws_the_motion_of_the_most_robust_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    let s = synthesize(
+        &out,
+        &["--no-export", "--seed", "1", "--report-motions", "3"],
+    );
+    let ranking: Vec<String> = s["ranking"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["id"].as_str().unwrap().to_string())
+        .collect();
+    assert!(ranking.len() > 3);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let start = "<script type=\"application/json\" id=\"foldsynth-data\">";
+    let data = &html[html.find(start).unwrap() + start.len()..];
+    let data: Value = serde_json::from_str(&data[..data.find("</script>").unwrap()]).unwrap();
+    let designs = data["designs"].as_array().unwrap();
+    assert_eq!(designs.len(), ranking.len());
+    for d in designs {
+        let id = d["id"].as_str().unwrap();
+        let rank = ranking.iter().position(|r| r == id).unwrap() + 1;
+        let frames = d["geometry"]["frames"].as_array().unwrap();
+        let noted = d["facts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f[0] == "motion");
+        let file: Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join("designs").join(format!("{id}.json"))).unwrap(),
+        )
+        .unwrap();
+        let motion = file["pattern"]["frames"].as_array().unwrap();
+        assert_eq!(motion.len(), 33);
+        if rank <= 3 {
+            assert_eq!(frames.len(), 33, "{id}");
+            assert!(!noted, "{id}");
+        } else {
+            assert_eq!(frames.len(), 1, "{id}");
+            assert!(noted, "{id}");
+            let last: Vec<f64> = motion[32]["coords"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .flat_map(|c| c.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()))
+                .collect();
+            let drawn: Vec<f64> = frames[0]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect();
+            assert_eq!(drawn.len(), last.len());
+            for (a, b) in drawn.iter().zip(&last) {
+                assert!((a - b).abs() <= 0.5e-4 + 1e-9, "{id}: {a} vs {b}");
+            }
+        }
+    }
+    // `all` draws every motion.
+    let every = dir.path().join("all");
+    synthesize(
+        &every,
+        &["--no-export", "--seed", "1", "--report-motions", "all"],
+    );
+    let html = std::fs::read_to_string(every.join("report.html")).unwrap();
+    assert!(!html.contains("\"motion\","));
 }

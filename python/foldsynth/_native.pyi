@@ -145,6 +145,8 @@ def synthesize(
     export: bool = True,
     export_top: Optional[int] = None,
     export_all: bool = False,
+    report_motions: Optional[int] = None,
+    report_motions_all: bool = False,
     shard: Optional[str] = None,
     rules: str = "r1,r2",
     post_check_only: bool = False,
@@ -156,3 +158,9 @@ def synthesize(
 
 def design_fold(path: _Path) -> str:
     """The FOLD 1.2 document (JSON text) of a design file ``designs/<id>.json``."""
+
+def design_frames(
+    path: _Path,
+) -> Tuple[List[float], List[List[Tuple[float, float, float]]], List[List[float]]]:
+    """A design file's frames as ``(t, coords, fold_angles)``, the fold angles the file
+    leaves out read from the vertex positions."""

@@ -2,7 +2,8 @@
 
 A run directory is what ``foldsynth synthesize`` (or ``foldsynth merge``) writes:
 ``settings.json``, ``alternatives.jsonl`` (one record per alternative), ``summary.json``
-(the counts and the ranking), ``designs/<id>.json`` and ``designs/<id>/`` (the files).
+(the counts and the ranking), ``designs/<id>.json`` (each design with its motion),
+``designs/<id>.fold`` and, for the most robust, ``designs/<id>/`` (the files).
 docs/outputs.md describes every field; nothing here reads anything else.
 """
 
@@ -103,6 +104,7 @@ def synthesize(
     resume: bool = False,
     force: bool = False,
     export: Union[bool, int, str] = True,
+    report_motions: Union[int, str] = 100,
     shard: Optional[str] = None,
     rules: str = "r1,r2",
     post_check_only: bool = False,
@@ -118,6 +120,8 @@ def synthesize(
     directory holding something else), ``export`` (``--export``: ``True`` writes every
     design's FOLD file and the other files of the 20 most robust, a number ``N`` those of
     the ``N`` most robust, ``"all"`` every design's, ``False`` = ``--no-export``),
+    ``report_motions`` (``--report-motions``: how many of the most robust designs
+    ``report.html`` draws with their whole motion, or ``"all"``),
     ``shard`` (``--shard``: ``"K/N"`` runs only shard K of N into ``out``, records only;
     ``foldsynth merge`` joins the shards, ``Run.open`` reads each), ``rules`` (``"r1,r2"``
     or ``"r1,r2,r2p"``), ``post_check_only``.
@@ -131,6 +135,14 @@ def synthesize(
     if not isinstance(task, _native.Task):
         task = _native.Task.load(os.fspath(task))
     on, top, every = _export_count(export)
+    if isinstance(report_motions, str) and report_motions.strip().lower() == "all":
+        motions, motions_all = None, True
+    elif isinstance(report_motions, numbers.Integral) and not isinstance(report_motions, bool) and report_motions >= 0:
+        motions, motions_all = int(report_motions), False
+    else:
+        raise ValueError(
+            f"report_motions={report_motions!r}: a number of designs (default 100) or 'all'"
+        )
     callback, bar = _progress_callback(progress)
     try:
         _native.synthesize(
@@ -146,6 +158,8 @@ def synthesize(
             export=on,
             export_top=top,
             export_all=every,
+            report_motions=motions,
+            report_motions_all=motions_all,
             shard=shard,
             rules=rules,
             post_check_only=post_check_only,
@@ -309,11 +323,12 @@ class Design:
     @property
     def frames(self) -> Frames:
         """The folded states as NumPy arrays (see ``Frames``)."""
-        frames = self.data["pattern"]["frames"]
+        # The file stores positions only; the native reader adds the fold angles.
+        t, coords, angles = _native.design_frames(os.fspath(self.path))
         return Frames(
-            t=np.array([f["t"] for f in frames], dtype=float),
-            coords=np.array([f["coords"] for f in frames], dtype=float),
-            fold_angles=np.array([f["fold_angles"] for f in frames], dtype=float),
+            t=np.array(t, dtype=float),
+            coords=np.array(coords, dtype=float).reshape(len(t), -1, 3),
+            fold_angles=np.array(angles, dtype=float).reshape(len(t), -1),
         )
 
     @property
@@ -324,11 +339,9 @@ class Design:
     def fold(self) -> Dict[str, Any]:
         """The design's FOLD 1.2 document as a dict (``vertices_coords``,
         ``edges_vertices``, ``edges_assignment``, ``faces_vertices``, ``file_frames``…,
-        the FOLD format's own keys): the run's ``designs/<id>/<id>.fold`` when it wrote
-        one, else made from the design file exactly as ``foldsynth export`` makes it."""
-        written = self.run.path / "designs" / self.id / f"{self.id}.fold"
-        if written.exists():
-            return _read_json(written)
+        the FOLD format's own keys) with every frame of its motion, made from the design
+        file exactly as ``foldsynth export`` makes it (the run's own FOLD file of a design
+        outside ``--export N`` holds the folded form only)."""
         return json.loads(_native.design_fold(os.fspath(self.path)))
 
     def save_fold(self, path: PathLike) -> pathlib.Path:

@@ -210,6 +210,8 @@ impl Task {
             None,
             false,
             None,
+            false,
+            None,
             rules,
             post_check_only,
             None,
@@ -681,6 +683,7 @@ fn foldsynth_module(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(vertex, m)?)?;
     m.add_function(wrap_pyfunction!(run::synthesize, m)?)?;
     m.add_function(wrap_pyfunction!(run::design_fold, m)?)?;
+    m.add_function(wrap_pyfunction!(run::design_frames, m)?)?;
     m.add("FoldsynthError", m.py().get_type::<FoldsynthError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -159,7 +159,7 @@ pub fn search<'py>(
 /// `callback(phase, unit, done, total, finished)` with its progress; returns the summary.
 /// `foldsynth.synthesize` wraps it and returns a `Run`.
 #[pyfunction]
-#[pyo3(signature = (task, out, *, jobs = 0, starts = 16, seed = 0, resume = false, force = false, n_max = None, sweep = 181, export = true, export_top = None, export_all = false, shard = None, rules = "r1,r2", post_check_only = false, callback = None))]
+#[pyo3(signature = (task, out, *, jobs = 0, starts = 16, seed = 0, resume = false, force = false, n_max = None, sweep = 181, export = true, export_top = None, export_all = false, report_motions = None, report_motions_all = false, shard = None, rules = "r1,r2", post_check_only = false, callback = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn synthesize<'py>(
     py: Python<'py>,
@@ -175,6 +175,8 @@ pub fn synthesize<'py>(
     export: bool,
     export_top: Option<usize>,
     export_all: bool,
+    report_motions: Option<usize>,
+    report_motions_all: bool,
     shard: Option<&str>,
     rules: &str,
     post_check_only: bool,
@@ -218,6 +220,12 @@ pub fn synthesize<'py>(
         progress: false,
         rules,
         post_check_only,
+        // As `export`: a number, every design, or the CLI's default.
+        report_motions: if report_motions_all {
+            None
+        } else {
+            Some(report_motions.unwrap_or(search::REPORT_MOTIONS))
+        },
         ..SearchOptions::default()
     };
     search(py, &task.task, opts, shard, callback)
@@ -230,6 +238,26 @@ pub fn design_fold(py: Python<'_>, path: PathBuf) -> PyResult<String> {
     py.detach(|| -> anyhow::Result<String> {
         let d = DesignFile::read(&path)?;
         Ok(fold::to_fold_string(&d.pattern, &d.meta, FoldSpec::V1_2)?)
+    })
+    .map_err(fs_err)
+}
+
+/// A design file's frames as `(t, coords, fold_angles)`: the fold angles the file leaves
+/// out read from the positions, as every reader of design files does.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+pub fn design_frames(
+    py: Python<'_>,
+    path: PathBuf,
+) -> PyResult<(Vec<f64>, Vec<Vec<[f64; 3]>>, Vec<Vec<f64>>)> {
+    py.detach(|| -> anyhow::Result<_> {
+        let d = DesignFile::read(&path)?;
+        let frames = d.pattern.frames;
+        Ok((
+            frames.iter().map(|f| f.t).collect(),
+            frames.iter().map(|f| f.coords.clone()).collect(),
+            frames.into_iter().map(|f| f.fold_angles).collect(),
+        ))
     })
     .map_err(fs_err)
 }

@@ -110,7 +110,14 @@ def test_a_design_folds_rigidly_and_its_model_agrees(run, task):
     length0 = np.linalg.norm(flat[ends[:, 0]] - flat[ends[:, 1]], axis=1)
     lengths = np.linalg.norm(f.coords[:, ends[:, 0]] - f.coords[:, ends[:, 1]], axis=2)
     assert np.abs(lengths - length0).max() < 1e-9
-    np.testing.assert_allclose(f.coords[0][:, :2], flat, atol=1e-12)
+    # The flat state, to the ten significant digits a design file stores positions with.
+    np.testing.assert_allclose(f.coords[0][:, :2], flat, rtol=1e-9, atol=1e-12)
+    # Its fold angles are read from the positions: valley positive, 0 on the boundary, and
+    # each crease's angle at the folded form is the one the FOLD file carries.
+    kinds = [e["kind"] for e in pattern["edges"]]
+    assert all(f.fold_angles[:, k].max() == 0.0 for k, kd in enumerate(kinds) if kd == "boundary")
+    # (read from ten-digit positions: within 1e-7 rad; docs/outputs.md measured 4.6e-8)
+    np.testing.assert_allclose(f.fold_angles[0], 0.0, atol=1e-7)
     assert np.array_equal(best.tip_path, f.coords[:, best.gripping_vertex - 1])
 
     # The compiled model at the design reproduces the search's Ω*.
@@ -231,19 +238,35 @@ def test_open_reads_a_run_merged_from_shards(run, cli, tmp_path):
 def test_export_counts_as_the_cli(run, task, tmp_path):
     # export=N: every design gets its FOLD file, the N most robust every file (as --export N).
     r = foldsynth.synthesize(
-        task, out=tmp_path / "three", n_max=N_MAX, starts=STARTS, export=3, progress=False
+        task,
+        out=tmp_path / "three",
+        n_max=N_MAX,
+        starts=STARTS,
+        export=3,
+        report_motions=2,
+        progress=False,
     )
     ids = list(r.designs()["id"])
     assert ids == list(run.designs()["id"]) and len(ids) > 3
-    files = {i: sorted(p.name for p in (tmp_path / "three" / "designs" / i).iterdir()) for i in ids}
-    assert all(len(files[i]) > 1 for i in ids[:3])
-    assert all(files[i] == [f"{i}.fold"] for i in ids[3:])
+    designs = tmp_path / "three" / "designs"
+    assert all((designs / f"{i}.fold").is_file() for i in ids)
+    assert all(len(list((designs / i).iterdir())) == 15 for i in ids[:3])
+    assert not any((designs / i).exists() for i in ids[3:])
+    # report_motions=2 (--report-motions 2): the page draws the motion of the 2 most
+    # robust designs, the folded form (one frame) of the others.
+    html = (tmp_path / "three" / "report.html").read_text(encoding="utf-8")
+    tag = '<script type="application/json" id="foldsynth-data">'
+    data = json.loads(html[html.index(tag) + len(tag) :].split("</script>", 1)[0])
+    drawn = {d["id"]: len(d["geometry"]["frames"]) for d in data["designs"]}
+    assert [drawn[i] for i in ids] == [33, 33] + [1] * (len(ids) - 2)
 
 
 def test_synthesize_rejects_bad_settings(task, tmp_path):
     for bad in (-1, 2.5, "some"):
         with pytest.raises(ValueError, match="export"):
             foldsynth.synthesize(task, out=tmp_path / "e", export=bad, progress=False)
+        with pytest.raises(ValueError, match="report_motions"):
+            foldsynth.synthesize(task, out=tmp_path / "m", report_motions=bad, progress=False)
     with pytest.raises(ValueError, match="shard"):
         foldsynth.synthesize(task, out=tmp_path / "s", shard="3/2", progress=False)
     with pytest.raises(ValueError, match="starts"):

@@ -27,6 +27,10 @@ pub struct MergeArgs {
     /// `all` (see synthesize --export).
     #[arg(long, value_name = "N|all", default_value_t = ExportCount(Some(crate::search::EXPORT_TOP)), value_parser = clap::value_parser!(ExportCount))]
     pub export: ExportCount,
+    /// Draw the whole motion of the N most robust designs in report.html (default 100),
+    /// or of every design with `all` (see synthesize --report-motions).
+    #[arg(long, value_name = "N|all", default_value_t = ExportCount(Some(crate::search::REPORT_MOTIONS)), value_parser = clap::value_parser!(ExportCount))]
+    pub report_motions: ExportCount,
     /// Use OUT even if it holds a run of other settings (see synthesize --force).
     #[arg(long)]
     pub force: bool,
@@ -45,6 +49,7 @@ pub fn run(args: MergeArgs) -> Result<()> {
             jobs: args.jobs,
             export: !args.no_export,
             export_top: args.export.0,
+            report_motions: args.report_motions.0,
         },
     )?;
     if args.json {

@@ -203,23 +203,13 @@ pub fn read_design(path: &Path) -> anyhow::Result<(String, Pattern)> {
             path.display()
         ),
     };
-    let pattern: Pattern = serde_json::from_value(body).with_context(|| {
+    let mut pattern: Pattern = serde_json::from_value(body).with_context(|| {
         format!(
             "{}: pattern: expected {{vertices, edges, faces, frames}} as foldsynth writes them",
             path.display()
         )
     })?;
-    crate::export::validate_pattern(&pattern).with_context(|| format!("{}", path.display()))?;
-    for (k, f) in pattern.frames.iter().enumerate() {
-        if f.coords.len() != pattern.vertices.len() {
-            bail!(
-                "{}: pattern.frames[{k}].coords: {} positions for {} vertices",
-                path.display(),
-                f.coords.len(),
-                pattern.vertices.len()
-            );
-        }
-    }
+    crate::export::read_pattern(&mut pattern).with_context(|| format!("{}", path.display()))?;
     let name = v
         .get("id")
         .and_then(|x| x.as_str())

@@ -51,6 +51,11 @@ pub struct SynthesizeArgs {
     /// writes any other design's files.
     #[arg(long, value_name = "N|all", default_value_t = ExportCount(Some(search::EXPORT_TOP)), value_parser = clap::value_parser!(ExportCount))]
     pub export: ExportCount,
+    /// Draw the whole motion of the N most robust designs in report.html (default 100),
+    /// or of every design with `all`; the others are drawn in their folded form (a
+    /// design's motion is 5–8 KB of the page).
+    #[arg(long, value_name = "N|all", default_value_t = ExportCount(Some(search::REPORT_MOTIONS)), value_parser = clap::value_parser!(ExportCount))]
+    pub report_motions: ExportCount,
     /// Run only shard K of N (1 ≤ K ≤ N) of the search: a deterministic, cost-balanced
     /// share of its models, into its own directory (records only; `foldsynth merge` makes
     /// the whole run of all N). Resumable with --resume like a whole run.
@@ -89,6 +94,7 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         sweep: args.sweep,
         export: !args.no_export,
         export_top: args.export.0,
+        report_motions: args.report_motions.0,
         progress: true,
         rules: args.rules,
         post_check_only: args.post_check_only,

@@ -45,6 +45,8 @@ pub struct MergeOptions {
     pub export: bool,
     /// With `export`, of only this many most robust designs (`None`: all).
     pub export_top: Option<usize>,
+    /// How many most robust designs the report draws with their motion (`None`: all).
+    pub report_motions: Option<usize>,
 }
 
 /// One shard directory, read.
@@ -394,6 +396,7 @@ fn search_options(
         sweep: settings.sweep,
         export: opts.export,
         export_top: opts.export_top,
+        report_motions: opts.report_motions,
         progress: false,
         rules,
         post_check_only: settings.post_check_only,

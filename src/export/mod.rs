@@ -12,6 +12,7 @@
 //! - [`raster`]: the GIF's frames drawn straight into palette entries,
 //! - [`lzw`]: the GIF frames' LZW compression, with a fast path for runs,
 //! - [`mesh`]: OBJ and STL of a folded state,
+//! - [`motion`]: a design's frames as its JSON stores them (positions; fold angles read back),
 //! - [`plots`]: the search tree (thesis Fig. 48) and the distribution of designs (Fig. 51),
 //! - [`report`]: the self-contained, interactive `report.html` (three.js inlined),
 //! - [`laser`], [`print`](mod@print): a thick design's ply drawings (DXF, SVG) and solids (STL, 3MF),
@@ -31,6 +32,7 @@ pub mod laser;
 pub mod lzw;
 pub mod mesh;
 pub mod meta_file;
+pub mod motion;
 pub mod palette;
 pub mod plots;
 pub mod print;
@@ -281,6 +283,33 @@ pub fn validate_pattern(p: &Pattern) -> Result<()> {
         )?;
     }
     Ok(())
+}
+
+/// A pattern as a design file gives it, made whole and checked: the fold angles it leaves
+/// out ([`motion`]) read from the positions once the indices are known to be valid, then
+/// [`validate_pattern`].
+pub fn read_pattern(p: &mut Pattern) -> Result<()> {
+    let bare = Pattern {
+        vertices: p.vertices.clone(),
+        edges: p.edges.clone(),
+        faces: p.faces.clone(),
+        frames: Vec::new(),
+    };
+    validate_pattern(&bare)?;
+    for (j, f) in p.frames.iter().enumerate() {
+        if f.coords.len() != p.vertices.len() {
+            return Err(ExportError::invalid(
+                format!("pattern.frames[{j}].coords"),
+                format!(
+                    "{} entries, expected one per vertex ({})",
+                    f.coords.len(),
+                    p.vertices.len()
+                ),
+            ));
+        }
+    }
+    motion::fill_fold_angles(p)?;
+    validate_pattern(p)
 }
 
 /// Check the metadata against the pattern it describes.
@@ -575,7 +604,8 @@ pub fn with_meshes(meta: &DesignMeta) -> Result<std::borrow::Cow<'_, DesignMeta>
 ///
 /// `pattern` is [`Pattern`] as serde writes it (`vertices`, `edges` with
 /// `{"v": [i, j], "kind": "boundary" | {"crease": {"driven": bool}}}`, `faces`, `frames`
-/// with `t`, `coords`, `fold_angles` in radians); `meta` is [`DesignMeta`].
+/// with `t`, `coords`, `fold_angles` in radians; `fold_angles` may be left out, and
+/// then they are read from `coords`, see [`motion`]); `meta` is [`DesignMeta`].
 ///
 /// Other keys are allowed and ignored: `foldsynth synthesize` writes its designs
 /// (`OUT/designs/<id>.json`) as such files with the optimization's figures beside them.
@@ -600,7 +630,7 @@ impl DesignFile {
 
     /// Parse and validate design JSON text; `source` names it in messages.
     pub fn parse(text: &str, source: &str) -> Result<DesignFile> {
-        let d: DesignFile = serde_json::from_str(text).map_err(|e| {
+        let mut d: DesignFile = serde_json::from_str(text).map_err(|e| {
             ExportError::invalid(
                 source,
                 format!(
@@ -609,7 +639,7 @@ impl DesignFile {
                 ),
             )
         })?;
-        validate_pattern(&d.pattern)
+        read_pattern(&mut d.pattern)
             .and_then(|()| validate_meta(&d.meta, &d.pattern))
             .map_err(|e| ExportError::invalid(source, e.to_string()))?;
         Ok(d)

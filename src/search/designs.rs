@@ -66,32 +66,33 @@ pub(super) fn write_designs(
                 .map(|(k, rec)| build_design(task, plan, c * 256 + k + 1, rec, opts.sweep))
                 .collect::<Result<Vec<_>, _>>()
         })?;
-        // Listed before they are written, so a kill leaves nothing unlisted.
-        let mut files: Vec<PathBuf> = work
-            .iter()
-            .map(|w| out_dir.path(&format!("designs/{}.json", w.id)))
-            .collect();
+        // Listed before they are written, so a kill leaves nothing unlisted: every
+        // design's JSON and (with export) its FOLD file beside it; the most robust also
+        // their directory of files, as `foldsynth export --format all` writes it.
+        let mut files: Vec<PathBuf> = Vec::new();
+        for w in &work {
+            files.push(out_dir.path(&format!("designs/{}.json", w.id)));
+            if what(w.rank) != Written::None {
+                files.push(out_dir.path(&format!("designs/{}.fold", w.id)));
+            }
+        }
         let with_dir: Vec<&DesignWork> = work
             .iter()
-            .filter(|w| what(w.rank) != Written::None)
+            .filter(|w| what(w.rank) == Written::All)
             .collect();
         let dirs: Vec<String> = with_dir
             .iter()
             .map(|w| format!("designs/{}", w.id))
             .collect();
         for (w, dir) in with_dir.into_iter().zip(out_dir.create_dirs(&dirs)?) {
-            let planned = export::planned_files(&dir, &w.pattern, &w.options);
-            match what(w.rank) {
-                Written::All => files.extend(planned.all()),
-                _ => files.push(planned.fold),
-            }
+            files.extend(export::planned_files(&dir, &w.pattern, &w.options).all());
         }
         out_dir.register(&files)?;
         let written = pool.install(|| {
             work.into_par_iter()
                 .map(|w| {
                     let files = what(w.rank);
-                    let mut card = write_design(w, files, out_dir, progress)?;
+                    let mut card = write_design(w, files, opts.report_motions, out_dir, progress)?;
                     if files == Written::Fold {
                         card.facts.push(files_on_demand(&card.id, out_dir, opts));
                     }
@@ -109,9 +110,11 @@ pub(super) fn write_designs(
 enum Written {
     /// None (`--no-export`).
     None,
-    /// Its FOLD file (a design outside `--export N`'s most robust).
+    /// Its FOLD file of the crease pattern and folded form, `designs/<id>.fold` (a design
+    /// outside `--export N`'s most robust).
     Fold,
-    /// Every file (FOLD, SVG, meshes, pictures, GIF).
+    /// That, and every file of `foldsynth export --format all` in `designs/<id>/` (FOLD
+    /// with the motion, SVG, meshes, pictures, GIF).
     All,
 }
 
@@ -192,7 +195,8 @@ fn build_design(
         "requirements": rec.requirements,
         "fabrication": thick.as_ref().map(|t| &t.doc),
         "rank": rank,
-        "pattern": pattern,
+        // The motion once: positions to ten digits, fold angles read back (issue 35).
+        "pattern": export::motion::pattern_json(&pattern),
         "meta": meta,
         "svg": export::svg::svg_scale(&pattern, &Default::default()).ok(),
     });
@@ -223,7 +227,7 @@ fn files_on_demand(id: &str, out_dir: &OutputDir, opts: &SearchOptions) -> Fact 
     Fact::new(
         "files",
         format!(
-            "the FOLD file; the SVG, meshes, pictures and animation are written for the {n} most robust designs (--export {n}); this one's: foldsynth export {} --format all --out {}",
+            "the FOLD file (crease pattern, folded form); the rest, as for the {n} most robust: foldsynth export {} --format all --out {}",
             shell_word(&out_dir.path(&format!("designs/{id}.json"))),
             shell_word(&out_dir.path(&format!("designs/{id}"))),
         ),
@@ -248,6 +252,7 @@ fn shell_word(path: &Path) -> String {
 fn write_design(
     w: DesignWork,
     files: Written,
+    report_motions: Option<usize>,
     out_dir: &OutputDir,
     progress: &Progress,
 ) -> Result<ReportDesign, SearchError> {
@@ -258,42 +263,66 @@ fn write_design(
         source,
     })?;
     let err = |e: export::ExportError| SearchError::Export(e.to_string());
-    let out = out_dir.path(&format!("designs/{id}"));
-    let written = match files {
-        Written::None => None,
-        Written::All => {
-            Some(export::write_all(&out, &w.pattern, &w.meta, &w.options).map_err(err)?)
+    let verified = |fold: &Path| {
+        let check = export::verify::verify_file(fold, &Default::default())
+            .map_err(|e| SearchError::Export(e.to_string()))?;
+        if !check.ok {
+            eprintln!(
+                "BUG: the exported FOLD file {} fails verification",
+                fold.display()
+            );
         }
-        Written::Fold => {
-            // The FOLD file alone, as `write_all` writes it; the other paths stay empty
-            // (the report links only what exists).
-            let fold = export::planned_files(&out, &w.pattern, &w.options).fold;
-            let meta = export::with_meshes(&w.meta).map_err(err)?;
-            let text = export::fold::to_fold_string(&w.pattern, &meta, w.options.fold_spec)
+        Ok::<_, SearchError>(check)
+    };
+    let (written, check) = if files == Written::None {
+        (None, None)
+    } else {
+        // `designs/<id>.fold`: the crease pattern and its folded form (the last frame),
+        // what Origami Simulator and the FOLD tools open; the motion is the design JSON's
+        // (issue 35: it was written twice per design), and `foldsynth export` makes FOLD
+        // frames of it, as it does below for the most robust.
+        let fold = out_dir.path(&format!("designs/{id}.fold"));
+        let meta = export::with_meshes(&w.meta).map_err(err)?;
+        let text =
+            export::fold::to_fold_string(&w.pattern.folded_form(), &meta, w.options.fold_spec)
                 .map_err(err)?;
-            std::fs::write(&fold, text).map_err(|source| SearchError::Io {
-                path: fold.display().to_string(),
-                source,
-            })?;
-            Some(export::Files {
+        std::fs::write(&fold, text).map_err(|source| SearchError::Io {
+            path: fold.display().to_string(),
+            source,
+        })?;
+        let check = verified(&fold)?;
+        if files == Written::All {
+            let out = out_dir.path(&format!("designs/{id}"));
+            let all = export::write_all(&out, &w.pattern, &w.meta, &w.options).map_err(err)?;
+            let check = verified(&all.fold)?;
+            (Some(all), Some(check))
+        } else {
+            // The other paths stay empty (the report links only what exists).
+            let f = export::Files {
                 fold,
                 ..Default::default()
-            })
+            };
+            (Some(f), Some(check))
         }
-    };
-    let check = match &written {
-        Some(f) => {
-            let check = export::verify::verify_file(&f.fold, &Default::default())
-                .map_err(|e| SearchError::Export(e.to_string()))?;
-            if !check.ok {
-                eprintln!("BUG: the exported FOLD file of {id} fails verification");
-            }
-            Some(check)
-        }
-        None => None,
     };
     progress.inc(1);
-    let mut card = report_design(&w.rec, w.threshold, w.pattern, w.meta, path, written, check);
+    // Outside the `REPORT_MOTIONS` most robust, the page draws the folded form alone.
+    let motion = report_motions.is_none_or(|n| w.rank <= n);
+    let drawn = if motion {
+        w.pattern
+    } else {
+        w.pattern.folded_form()
+    };
+    let mut card = report_design(&w.rec, w.threshold, drawn, w.meta, path, written, check);
+    if !motion {
+        card.facts.push(Fact::new(
+            "motion",
+            format!(
+                "its folded form (this page draws the motion of the {} most robust designs; --report-motions)",
+                report_motions.unwrap_or_default()
+            ),
+        ));
+    }
     card.thick = w.thick;
     Ok(card)
 }

@@ -40,6 +40,9 @@ pub struct SearchOptions {
     /// With `export`, the files of only the this many most robust designs (the report's
     /// ranking); `None`: of every design. The report gives the others' command.
     pub export_top: Option<usize>,
+    /// How many of the most robust designs `report.html` draws with their whole motion
+    /// (the others with their folded form); `None`: every design.
+    pub report_motions: Option<usize>,
     /// Show progress on stderr: a bar on a terminal, a status line every few seconds
     /// otherwise (see [`Progress`](super::Progress)).
     pub progress: bool,
@@ -66,6 +69,7 @@ impl Default for SearchOptions {
             sweep: 181,
             export: true,
             export_top: Some(EXPORT_TOP),
+            report_motions: Some(REPORT_MOTIONS),
             progress: true,
             rules: Rules::default(),
             post_check_only: false,
@@ -77,7 +81,13 @@ impl Default for SearchOptions {
 /// How many of the most robust designs a run exports by default (`--export N`).
 pub const EXPORT_TOP: usize = 20;
 
-/// `--export N|all`: the files of the N most robust designs, or of all.
+/// How many of the most robust designs `report.html` draws with their whole motion by
+/// default (`--report-motions N|all`); the others with their folded form alone (a design's motion is 5–8 KB of the page: a run's
+/// page stays a few MB however many designs it keeps, issue 35).
+pub const REPORT_MOTIONS: usize = 100;
+
+/// `--export N|all` (the files of the N most robust designs, or of all), also
+/// `--report-motions N|all`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ExportCount(pub Option<usize>);
 
@@ -96,12 +106,15 @@ impl std::str::FromStr for ExportCount {
         if s.trim().eq_ignore_ascii_case("all") {
             return Ok(ExportCount(None));
         }
-        s.trim().parse::<usize>().map(|n| ExportCount(Some(n))).map_err(|_| {
-            format!(
-                "'{}' is neither a number of designs nor 'all' (e.g. --export 50, --export all; --no-export for none)",
-                crate::text::excerpt(s, 40)
-            )
-        })
+        s.trim()
+            .parse::<usize>()
+            .map(|n| ExportCount(Some(n)))
+            .map_err(|_| {
+                format!(
+                    "'{}' is neither a number of designs nor 'all' (e.g. 50 or all)",
+                    crate::text::excerpt(s, 40)
+                )
+            })
     }
 }
 
