@@ -1,5 +1,5 @@
 //! A design's motion as `designs/<id>.json` stores it: each frame's `t` and vertex
-//! positions, rounded to [`DIGITS`] significant digits, without its fold angles, which are
+//! positions, both rounded to [`DIGITS`] significant digits, without its fold angles, which are
 //! read back from the positions ([`fill_fold_angles`]).
 //!
 //! Why: the 33 frames are three quarters of a design file, and a search writes one per
@@ -30,7 +30,7 @@ pub fn round_sig(x: f64) -> f64 {
 }
 
 /// `p` as the design file stores it: [`Pattern`]'s fields, each frame with `t` and
-/// `coords` (rounded) only.
+/// `coords` only (both rounded).
 pub fn pattern_json(p: &Pattern) -> Value {
     let frames: Vec<Value> = p
         .frames
@@ -41,7 +41,7 @@ pub fn pattern_json(p: &Pattern) -> Value {
                 .iter()
                 .map(|c| [round_sig(c[0]), round_sig(c[1]), round_sig(c[2])])
                 .collect();
-            json!({"t": f.t, "coords": coords})
+            json!({"t": round_sig(f.t), "coords": coords})
         })
         .collect();
     json!({
@@ -112,7 +112,7 @@ mod tests {
             assert!(q.frames.iter().all(|f| f.fold_angles.is_empty()));
             fill_fold_angles(&mut q).unwrap();
             for (a, b) in p.frames.iter().zip(&q.frames) {
-                assert_eq!(a.t, b.t);
+                assert_eq!(round_sig(a.t), b.t);
                 for (x, y) in a.fold_angles.iter().zip(&b.fold_angles) {
                     assert!((x - y).abs() < 1e-8, "γ {gamma}: {x} vs {y}");
                 }

@@ -170,7 +170,10 @@ fn build_design(
         let (_, g) = crate::model::compiled::outputs_f64(&model, &free, &design.modes);
         g.iter()
             .enumerate()
-            .map(|(k, v)| json!({"label": model.constraint_label(k), "value": v}))
+            // Ten digits, as the motion's positions: informative, not read back.
+            .map(|(k, v)| {
+                json!({"label": model.constraint_label(k), "value": export::motion::round_sig(*v)})
+            })
             .collect()
     };
     let id = rec.id();
