@@ -3,7 +3,8 @@
 //!
 //! One file per benchmark: [`vertex`] (one vertex, with the CasADi peer in [`casadi`]),
 //! [`model`] (one design model), [`numeric`] (one motion: compiled PTU against the
-//! bar-and-hinge simulation), [`export`] (one design's files); [`symbolica`] is the
+//! bar-and-hinge simulation), [`export`] (one design's files), [`optimize`] (our optimizer
+//! against IPOPT on a task's alternatives); [`symbolica`] is the
 //! Symbolica peer of `vertex` and `model`. This file holds what they share and imports
 //! none of them.
 
@@ -14,6 +15,7 @@ pub mod casadi;
 pub mod export;
 pub mod model;
 pub mod numeric;
+pub mod optimize;
 pub mod symbolica;
 pub mod vertex;
 

@@ -34,6 +34,10 @@ pub enum BenchCommand {
     /// One design's files, part by part (FOLD, SVG, meshes, pictures, GIF frames and their
     /// LZW against the gif crate's), on one thread.
     Export(super::bench_export::ExportBenchArgs),
+    /// Our optimizer against IPOPT (the CasADi wheel's) on a task's alternatives from the
+    /// same starting points: the share that meets the target, and that meets it feasibly,
+    /// starts, evaluations and CPU time per alternative.
+    Optimize(super::bench_optimize::OptimizeBenchArgs),
 }
 
 /// Run `foldsynth bench`.
@@ -43,6 +47,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         BenchCommand::Model(a) => super::bench_model::run(a),
         BenchCommand::Numeric(a) => super::bench_numeric::run(a),
         BenchCommand::Export(a) => super::bench_export::run(a),
+        BenchCommand::Optimize(a) => super::bench_optimize::run(a),
     }
 }
 

@@ -6,6 +6,7 @@ pub mod bench;
 pub mod bench_export;
 pub mod bench_model;
 pub mod bench_numeric;
+pub mod bench_optimize;
 pub mod compile;
 pub mod enumerate;
 pub mod export;

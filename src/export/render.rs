@@ -767,7 +767,7 @@ pub(crate) fn encode_png(pm: &Pixmap) -> Result<Vec<u8>> {
     let mut enc = png::Encoder::new(&mut out, pm.width(), pm.height());
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
-    enc.set_compression(png::Compression::High);
+    enc.set_compression(png::Compression::Balanced);
     let mut writer = enc.write_header().map_err(img)?;
     writer.write_image_data(&rgb).map_err(img)?;
     writer.finish().map_err(img)?;

@@ -604,7 +604,7 @@ impl SharedStarts {
 
 /// Whether [`Options::give_up_after`] stops a problem after `starts_run` starts whose
 /// best feasible objective is `best_feasible_f` (infinite when none was feasible).
-fn gives_up(opts: &Options, starts_run: usize, best_feasible_f: f64) -> bool {
+pub fn gives_up(opts: &Options, starts_run: usize, best_feasible_f: f64) -> bool {
     if opts.all_starts {
         return false;
     }
@@ -615,6 +615,18 @@ fn gives_up(opts: &Options, starts_run: usize, best_feasible_f: f64) -> bool {
         }
         _ => false,
     }
+}
+
+/// The starting points [`minimize`] runs `problem` from with `opts`, in order (for a peer
+/// solver to start from the same points).
+pub fn start_points<P: Problem>(problem: &P, opts: &Options) -> Vec<Vec<f64>> {
+    let n = problem.n_vars();
+    let (lo, hi): (Vec<f64>, Vec<f64>) = (0..n).map(|i| problem.bounds(i)).unzip();
+    let transform = Transform { lo, hi };
+    quasi_random_points(n, opts.starts, opts.seed)
+        .iter()
+        .map(|u| transform.start(u))
+        .collect()
 }
 
 /// Minimize `problem` from many starts (see the module docs).
