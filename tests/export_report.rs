@@ -78,6 +78,7 @@ fn sample_designs() -> Vec<ReportDesign> {
         files: None,
         verify: None,
         thick: None,
+        in_full: true,
     };
     vec![
         design("d-arm", 2, None, pa, ma, Some(rob_a)),
@@ -281,10 +282,16 @@ fn report_is_one_file_with_the_designs_geometry() {
         assert_eq!(m.matches("<script>").count(), 2);
         assert!(html.contains("FoldsynthThree"));
         assert_geometry_matches(&embedded(&html), &input);
-        // Every design id is a table row, in the given order; gripping vertices by name.
-        let ids = attrs(&m, "data-id");
+        // Every design id is a table row, in the given order, its values in column order
+        // (the page formats them: `vertex` writes a gripping vertex v7).
+        let data = embedded(&html);
+        let heads = attrs(&m, "data-key");
+        let col = |k: &str| heads.iter().position(|h| h == k).unwrap();
+        let rows = data["rows"].as_array().unwrap();
+        let ids: Vec<&str> = rows.iter().map(|r| r[0].as_str().unwrap()).collect();
         assert_eq!(ids, ["d-arm", "d-grip", "d-deg4"]);
-        assert!(m.contains("<td data-key=\"gripping\" data-v=\"7\">v7</td>"));
+        assert!(rows.iter().any(|r| r[col("gripping")] == 7));
+        assert!(m.contains("data-key=\"gripping\" data-numeric=\"false\" data-format=\"vertex\""));
         // Robustness columns exactly for the margins some design has.
         let heads = attrs(&m, "data-key");
         for k in [
@@ -412,10 +419,16 @@ fn search_writes_the_report_names_it_and_numbers_the_gripping_vertex_once() {
         let p = &last["vertices_coords"][g as usize - 1];
         let dist = ((f(&p[0])).powi(2) + f(&p[1]).powi(2) + (f(&p[2]) - 1.0).powi(2)).sqrt();
         assert!(dist <= 1e-5, "{id}: v{g} ends {dist} from P_G");
-        // The page says the same: a table cell v{g} in the design's row.
-        assert!(html.contains(&format!(
-            "<td data-key=\"gripping\" data-v=\"{g}\">v{g}</td>"
-        )));
+        // The page says the same: the design's row has gripping vertex g.
+        let heads = attrs(&html, "data-key");
+        let col = heads.iter().position(|h| h == "gripping").unwrap();
+        let row = data["rows"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r[0] == *id)
+            .unwrap();
+        assert_eq!(row[col], g);
     }
 }
 
@@ -547,6 +560,50 @@ fn drive(pages: &[&Path], broken: &Path) -> Value {
 }
 
 /// A copy of `report` alone in a fresh folder.
+/// The large page of [`report_works_in_headless_chromium_moved_alone`]: a page of 100 rows
+/// at a time, the next page the next 100 of the same order, and a design carried as a row
+/// only selected by its row: its values, and the command that draws it, no 3D view.
+fn assert_large_page_works(r: &Value, data: &Value) {
+    assert!(
+        r["errors"].as_array().unwrap().is_empty(),
+        "{}",
+        r["errors"]
+    );
+    assert_eq!(data["designs"].as_array().unwrap().len(), 3);
+    assert_eq!(data["rows"].as_array().unwrap().len(), 250);
+    let first = &r["pager"]["first"];
+    assert_eq!(first["pages"], 3);
+    assert_eq!(first["page"], 0);
+    assert_eq!(ids(&first["rows"]).len(), 100);
+    assert_eq!(first["info"], "rows 1–100 of 250 (page 1 of 3)");
+    let next = &r["pager"]["next"];
+    assert_eq!(next["page"], 1);
+    let (a, b) = (ids(&first["rows"]), ids(&next["rows"]));
+    assert_eq!(b.len(), 100);
+    assert!(a.iter().all(|id| !b.contains(id)), "pages overlap");
+    assert_eq!(next["info"], "rows 101–200 of 250 (page 2 of 3)");
+    // On opening, the page shows the first 100 of the most robust first order.
+    assert_eq!(ids(&r["initial"]["table"]["order"]).len(), 100);
+    let only = &r["rowOnly"];
+    let id = only["selected"].as_str().unwrap();
+    assert!(
+        !data["designs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|d| d["id"] == id),
+        "{id}"
+    );
+    assert!(only["title"].as_str().unwrap().starts_with(id));
+    assert_eq!(only["viewsHidden"], true);
+    let files = only["files"].as_str().unwrap();
+    assert!(
+        files.contains(&format!("foldsynth export designs/{id}.json --format all")),
+        "{files}"
+    );
+    assert!(only["facts"].as_u64().unwrap() >= 7, "{only}");
+}
+
 fn alone(report: &Path, dir: &Path, name: &str) -> PathBuf {
     let d = dir.join(name);
     std::fs::create_dir_all(&d).unwrap();
@@ -756,7 +813,23 @@ fn report_works_in_headless_chromium_moved_alone() {
     )
     .unwrap();
 
-    let v = drive(&[&sample, &real], &broken);
+    // A large page: 250 designs, the 3 first carried in full (as `--report-designs 3`
+    // makes it), the others rows only.
+    let (_, mut input) = build_report(&dir.path().join("large-src"), false);
+    let base = std::mem::take(&mut input.designs);
+    input.designs = (0..250)
+        .map(|i| {
+            let mut d = base[i % base.len()].clone();
+            d.id = format!("{}-{i:03}", d.id);
+            d.in_full = i < 3;
+            d
+        })
+        .collect();
+    let large = dir.path().join("large");
+    std::fs::create_dir_all(&large).unwrap();
+    let large = write_report(&large, &input).unwrap();
+
+    let v = drive(&[&sample, &real, &large], &broken);
     if v.is_null() {
         return;
     }
@@ -766,7 +839,11 @@ fn report_works_in_headless_chromium_moved_alone() {
         "{bad}"
     );
     let reports = v["reports"].as_array().unwrap();
-    assert_eq!(reports.len(), 2);
+    assert_eq!(reports.len(), 3);
+    assert_large_page_works(
+        &reports[2],
+        &embedded(&std::fs::read_to_string(&large).unwrap()),
+    );
     for (r, page) in reports.iter().zip([&sample, &real]) {
         let data = embedded(&std::fs::read_to_string(page).unwrap());
         assert_page_works(r, &data);
@@ -845,6 +922,7 @@ fn report_draws_every_shape_of_the_scene_once() {
         files: None,
         verify: None,
         thick: None,
+        in_full: true,
     };
     let input = ReportInput {
         summary: ReportSummary {

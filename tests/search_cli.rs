@@ -299,3 +299,69 @@ fn the_report_draws_the_motion_of_the_most_robust_only() {
     let html = std::fs::read_to_string(every.join("report.html")).unwrap();
     assert!(!html.contains("\"motion\","));
 }
+
+/// `--report-designs N`: the page carries the N most robust designs in full (card and
+/// geometry) and every design as a row of its table, with the values of the design's own
+/// JSON; the rest of the page does not grow with them.
+#[test]
+fn the_report_carries_the_most_robust_in_full_and_every_design_as_a_row() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    let s = synthesize(
+        &out,
+        &["--no-export", "--seed", "1", "--report-designs", "5"],
+    );
+    let ranking: Vec<String> = s["ranking"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["id"].as_str().unwrap().to_string())
+        .collect();
+    assert!(ranking.len() > 5);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    let start = "<script type=\"application/json\" id=\"foldsynth-data\">";
+    let data = &html[html.find(start).unwrap() + start.len()..];
+    let data: Value = serde_json::from_str(&data[..data.find("</script>").unwrap()]).unwrap();
+    let full: Vec<&str> = data["designs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["id"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        full,
+        ranking[..5].iter().map(String::as_str).collect::<Vec<_>>()
+    );
+    // Every design one row, in the ranking's order; its Ω* column is its JSON's objective.
+    let heads: Vec<&str> = html
+        .split("<th data-key=\"")
+        .skip(1)
+        .map(|t| &t[..t.find('"').unwrap()])
+        .collect();
+    let omega = heads.iter().position(|&h| h == "objective").unwrap();
+    let rows = data["rows"].as_array().unwrap();
+    let ids: Vec<&str> = rows.iter().map(|r| r[0].as_str().unwrap()).collect();
+    assert_eq!(ids, ranking.iter().map(String::as_str).collect::<Vec<_>>());
+    for r in rows {
+        let id = r[0].as_str().unwrap();
+        let file: Value = serde_json::from_str(
+            &std::fs::read_to_string(out.join("designs").join(format!("{id}.json"))).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(r[omega], file["meta"]["objective"], "{id}");
+        assert_eq!(r.as_array().unwrap().len(), heads.len(), "{id}");
+    }
+    // The page names the setting where it leaves designs out.
+    assert!(
+        html.contains("carries the 5 most robust designs in full (<code>--report-designs</code>)")
+    );
+    // `all`: every design in full.
+    let every = dir.path().join("all");
+    synthesize(
+        &every,
+        &["--no-export", "--seed", "1", "--report-designs", "all"],
+    );
+    let html = std::fs::read_to_string(every.join("report.html")).unwrap();
+    assert!(!html.contains("designs in full (<code>--report-designs</code>)"));
+    assert!(html.contains("\"rows\":["));
+}

@@ -147,6 +147,8 @@ def synthesize(
     export_all: bool = False,
     report_motions: Optional[int] = None,
     report_motions_all: bool = False,
+    report_designs: Optional[int] = None,
+    report_designs_all: bool = False,
     shard: Optional[str] = None,
     rules: str = "r1,r2",
     post_check_only: bool = False,

@@ -92,6 +92,15 @@ def _export_count(export: Union[bool, int, str]):
     )
 
 
+def _count_or_all(name: str, value: Union[int, str], default: int):
+    """``(N, False)`` for a number of designs, ``(None, True)`` for ``"all"``."""
+    if isinstance(value, str) and value.strip().lower() == "all":
+        return None, True
+    if isinstance(value, numbers.Integral) and not isinstance(value, bool) and value >= 0:
+        return int(value), False
+    raise ValueError(f"{name}={value!r}: a number of designs (default {default}) or 'all'")
+
+
 def synthesize(
     task: Union[_native.Task, PathLike],
     *,
@@ -105,6 +114,7 @@ def synthesize(
     force: bool = False,
     export: Union[bool, int, str] = True,
     report_motions: Union[int, str] = 100,
+    report_designs: Union[int, str] = 1000,
     shard: Optional[str] = None,
     rules: str = "r1,r2",
     post_check_only: bool = False,
@@ -121,7 +131,9 @@ def synthesize(
     design's FOLD file and the other files of the 20 most robust, a number ``N`` those of
     the ``N`` most robust, ``"all"`` every design's, ``False`` = ``--no-export``),
     ``report_motions`` (``--report-motions``: how many of the most robust designs
-    ``report.html`` draws with their whole motion, or ``"all"``),
+    ``report.html`` draws with their whole motion, or ``"all"``), ``report_designs``
+    (``--report-designs``: how many of the most robust designs it carries in full, every
+    design being a row of its table, or ``"all"``),
     ``shard`` (``--shard``: ``"K/N"`` runs only shard K of N into ``out``, records only;
     ``foldsynth merge`` joins the shards, ``Run.open`` reads each), ``rules`` (``"r1,r2"``
     or ``"r1,r2,r2p"``), ``post_check_only``.
@@ -135,14 +147,8 @@ def synthesize(
     if not isinstance(task, _native.Task):
         task = _native.Task.load(os.fspath(task))
     on, top, every = _export_count(export)
-    if isinstance(report_motions, str) and report_motions.strip().lower() == "all":
-        motions, motions_all = None, True
-    elif isinstance(report_motions, numbers.Integral) and not isinstance(report_motions, bool) and report_motions >= 0:
-        motions, motions_all = int(report_motions), False
-    else:
-        raise ValueError(
-            f"report_motions={report_motions!r}: a number of designs (default 100) or 'all'"
-        )
+    motions, motions_all = _count_or_all("report_motions", report_motions, 100)
+    designs, designs_all = _count_or_all("report_designs", report_designs, 1000)
     callback, bar = _progress_callback(progress)
     try:
         _native.synthesize(
@@ -160,6 +166,8 @@ def synthesize(
             export_all=every,
             report_motions=motions,
             report_motions_all=motions_all,
+            report_designs=designs,
+            report_designs_all=designs_all,
             shard=shard,
             rules=rules,
             post_check_only=post_check_only,

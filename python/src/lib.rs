@@ -212,6 +212,8 @@ impl Task {
             None,
             false,
             None,
+            false,
+            None,
             rules,
             post_check_only,
             None,

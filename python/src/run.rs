@@ -159,7 +159,7 @@ pub fn search<'py>(
 /// `callback(phase, unit, done, total, finished)` with its progress; returns the summary.
 /// `foldsynth.synthesize` wraps it and returns a `Run`.
 #[pyfunction]
-#[pyo3(signature = (task, out, *, jobs = 0, starts = 16, seed = 0, resume = false, force = false, n_max = None, sweep = 181, export = true, export_top = None, export_all = false, report_motions = None, report_motions_all = false, shard = None, rules = "r1,r2", post_check_only = false, callback = None))]
+#[pyo3(signature = (task, out, *, jobs = 0, starts = 16, seed = 0, resume = false, force = false, n_max = None, sweep = 181, export = true, export_top = None, export_all = false, report_motions = None, report_motions_all = false, report_designs = None, report_designs_all = false, shard = None, rules = "r1,r2", post_check_only = false, callback = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn synthesize<'py>(
     py: Python<'py>,
@@ -177,6 +177,8 @@ pub fn synthesize<'py>(
     export_all: bool,
     report_motions: Option<usize>,
     report_motions_all: bool,
+    report_designs: Option<usize>,
+    report_designs_all: bool,
     shard: Option<&str>,
     rules: &str,
     post_check_only: bool,
@@ -225,6 +227,11 @@ pub fn synthesize<'py>(
             None
         } else {
             Some(report_motions.unwrap_or(search::REPORT_MOTIONS))
+        },
+        report_designs: if report_designs_all {
+            None
+        } else {
+            Some(report_designs.unwrap_or(search::REPORT_DESIGNS))
         },
         ..SearchOptions::default()
     };

@@ -244,10 +244,11 @@ def test_export_counts_as_the_cli(run, task, tmp_path):
         starts=STARTS,
         export=3,
         report_motions=2,
+        report_designs=4,
         progress=False,
     )
     ids = list(r.designs()["id"])
-    assert ids == list(run.designs()["id"]) and len(ids) > 3
+    assert ids == list(run.designs()["id"]) and len(ids) > 4
     designs = tmp_path / "three" / "designs"
     assert all((designs / f"{i}.fold").is_file() for i in ids)
     assert all(len(list((designs / i).iterdir())) == 15 for i in ids[:3])
@@ -258,7 +259,10 @@ def test_export_counts_as_the_cli(run, task, tmp_path):
     tag = '<script type="application/json" id="foldsynth-data">'
     data = json.loads(html[html.index(tag) + len(tag) :].split("</script>", 1)[0])
     drawn = {d["id"]: len(d["geometry"]["frames"]) for d in data["designs"]}
-    assert [drawn[i] for i in ids] == [33, 33] + [1] * (len(ids) - 2)
+    # report_designs=4 (--report-designs 4): the 4 most robust in full, every design a row.
+    assert list(drawn) == ids[:4]
+    assert [drawn[i] for i in ids[:4]] == [33, 33, 1, 1]
+    assert [row[0] for row in data["rows"]] == ids
 
 
 def test_synthesize_rejects_bad_settings(task, tmp_path):
@@ -267,6 +271,8 @@ def test_synthesize_rejects_bad_settings(task, tmp_path):
             foldsynth.synthesize(task, out=tmp_path / "e", export=bad, progress=False)
         with pytest.raises(ValueError, match="report_motions"):
             foldsynth.synthesize(task, out=tmp_path / "m", report_motions=bad, progress=False)
+        with pytest.raises(ValueError, match="report_designs"):
+            foldsynth.synthesize(task, out=tmp_path / "d", report_designs=bad, progress=False)
     with pytest.raises(ValueError, match="shard"):
         foldsynth.synthesize(task, out=tmp_path / "s", shard="3/2", progress=False)
     with pytest.raises(ValueError, match="starts"):

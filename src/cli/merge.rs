@@ -31,6 +31,10 @@ pub struct MergeArgs {
     /// or of every design with `all` (see synthesize --report-motions).
     #[arg(long, value_name = "N|all", default_value_t = ExportCount(Some(crate::search::REPORT_MOTIONS)), value_parser = clap::value_parser!(ExportCount))]
     pub report_motions: ExportCount,
+    /// Carry the N most robust designs in full in report.html (default 1000), or every
+    /// design with `all` (see synthesize --report-designs).
+    #[arg(long, value_name = "N|all", default_value_t = ExportCount(Some(crate::search::REPORT_DESIGNS)), value_parser = clap::value_parser!(ExportCount))]
+    pub report_designs: ExportCount,
     /// Use OUT even if it holds a run of other settings (see synthesize --force).
     #[arg(long)]
     pub force: bool,
@@ -50,6 +54,7 @@ pub fn run(args: MergeArgs) -> Result<()> {
             export: !args.no_export,
             export_top: args.export.0,
             report_motions: args.report_motions.0,
+            report_designs: args.report_designs.0,
         },
     )?;
     if args.json {

@@ -56,6 +56,11 @@ pub struct SynthesizeArgs {
     /// design's motion is 5–8 KB of the page).
     #[arg(long, value_name = "N|all", default_value_t = ExportCount(Some(search::REPORT_MOTIONS)), value_parser = clap::value_parser!(ExportCount))]
     pub report_motions: ExportCount,
+    /// Carry the N most robust designs in full in report.html (card, 3D view, crease
+    /// pattern; default 1000), or every design with `all`; every design is a row of its
+    /// table either way, so a run of 100,000 designs still makes a page of about 13 MB.
+    #[arg(long, value_name = "N|all", default_value_t = ExportCount(Some(search::REPORT_DESIGNS)), value_parser = clap::value_parser!(ExportCount))]
+    pub report_designs: ExportCount,
     /// Run only shard K of N (1 ≤ K ≤ N) of the search: a deterministic, cost-balanced
     /// share of its models, into its own directory (records only; `foldsynth merge` makes
     /// the whole run of all N). Resumable with --resume like a whole run.
@@ -95,6 +100,7 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         export: !args.no_export,
         export_top: args.export.0,
         report_motions: args.report_motions.0,
+        report_designs: args.report_designs.0,
         progress: true,
         rules: args.rules,
         post_check_only: args.post_check_only,

@@ -47,6 +47,8 @@ pub struct MergeOptions {
     pub export_top: Option<usize>,
     /// How many most robust designs the report draws with their motion (`None`: all).
     pub report_motions: Option<usize>,
+    /// How many most robust designs the report carries in full (`None`: all).
+    pub report_designs: Option<usize>,
 }
 
 /// One shard directory, read.
@@ -397,6 +399,7 @@ fn search_options(
         export: opts.export,
         export_top: opts.export_top,
         report_motions: opts.report_motions,
+        report_designs: opts.report_designs,
         progress: false,
         rules,
         post_check_only: settings.post_check_only,

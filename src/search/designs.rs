@@ -92,8 +92,12 @@ pub(super) fn write_designs(
             work.into_par_iter()
                 .map(|w| {
                     let files = what(w.rank);
+                    let in_full = opts.report_designs.is_none_or(|n| w.rank <= n);
                     let mut card = write_design(w, files, opts.report_motions, out_dir, progress)?;
-                    if files == Written::Fold {
+                    if !in_full {
+                        // A row of the table only: what its cells show, nothing more held.
+                        card = row_only(card);
+                    } else if files == Written::Fold {
                         card.facts.push(files_on_demand(&card.id, out_dir, opts));
                     }
                     Ok::<_, SearchError>(card)
@@ -103,6 +107,48 @@ pub(super) fn write_designs(
         cards.extend(written);
     }
     Ok(cards)
+}
+
+/// A card reduced to its row of the report's table (outside `--report-designs N`): the
+/// page does not carry its geometry, and memory holds only what the row shows.
+fn row_only(card: ReportDesign) -> ReportDesign {
+    let m = card.meta;
+    ReportDesign {
+        pattern: Pattern {
+            vertices: Vec::new(),
+            edges: Vec::new(),
+            faces: Vec::new(),
+            frames: Vec::new(),
+        },
+        geometry: None,
+        meta: DesignMeta {
+            task: m.task,
+            rule_sequence: m.rule_sequence,
+            modes: m.modes,
+            gripping_vertex: m.gripping_vertex,
+            objective: m.objective,
+            ..Default::default()
+        },
+        facts: Vec::new(),
+        files: None,
+        verify: None,
+        thick: None,
+        // The values the row shows (score and margins), not their settings and places.
+        robustness: card.robustness.map(|r| {
+            let keep = |v: &serde_json::Value| match v.get("value") {
+                Some(x) => json!({"value": x}),
+                None => v.clone(),
+            };
+            match r {
+                serde_json::Value::Object(o) => {
+                    serde_json::Value::Object(o.iter().map(|(k, v)| (k.clone(), keep(v))).collect())
+                }
+                other => other,
+            }
+        }),
+        in_full: false,
+        ..card
+    }
 }
 
 /// Which of its files a design gets besides its JSON.

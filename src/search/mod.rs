@@ -45,8 +45,8 @@ pub use evaluate::prepare;
 pub use finish::finish;
 pub use open::{open_output, settings};
 pub use options::{
-    Alternative, EXPORT_TOP, Evaluation, ExportCount, FailedModel, REPORT_MOTIONS, SHARD_REPORT,
-    SHARD_TASK, SearchError, SearchOptions, ShardReport, Share, check_search,
+    Alternative, EXPORT_TOP, Evaluation, ExportCount, FailedModel, REPORT_DESIGNS, REPORT_MOTIONS,
+    SHARD_REPORT, SHARD_TASK, SearchError, SearchOptions, ShardReport, Share, check_search,
 };
 pub use plan::{Plan, plan};
 pub use progress::{

@@ -43,6 +43,10 @@ pub struct SearchOptions {
     /// How many of the most robust designs `report.html` draws with their whole motion
     /// (the others with their folded form); `None`: every design.
     pub report_motions: Option<usize>,
+    /// `report.html` carries the card, 3D view and crease pattern of this many of the most
+    /// robust designs, and every other design as a row of its table; `None`: every design
+    /// in full (`--report-designs N|all`, default [`REPORT_DESIGNS`]).
+    pub report_designs: Option<usize>,
     /// Show progress on stderr: a bar on a terminal, a status line every few seconds
     /// otherwise (see [`Progress`](super::Progress)).
     pub progress: bool,
@@ -70,6 +74,7 @@ impl Default for SearchOptions {
             export: true,
             export_top: Some(EXPORT_TOP),
             report_motions: Some(REPORT_MOTIONS),
+            report_designs: Some(REPORT_DESIGNS),
             progress: true,
             rules: Rules::default(),
             post_check_only: false,
@@ -86,8 +91,14 @@ pub const EXPORT_TOP: usize = 20;
 /// page stays a few MB however many designs it keeps, issue 35).
 pub const REPORT_MOTIONS: usize = 100;
 
+/// How many of the most robust designs `report.html` carries in full by default
+/// (`--report-designs N|all`): a design in full is about 3 KB of the page with its folded
+/// form, a row of the table about 100 bytes, so a run of 100,000 designs makes a page of
+/// about 13 MB (issue 34).
+pub const REPORT_DESIGNS: usize = 1000;
+
 /// `--export N|all` (the files of the N most robust designs, or of all), also
-/// `--report-motions N|all`.
+/// `--report-motions N|all` and `--report-designs N|all`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ExportCount(pub Option<usize>);
 

@@ -345,6 +345,7 @@ pub(super) fn report_design(
         files,
         verify,
         thick: None,
+        in_full: true,
     }
 }
 

@@ -212,6 +212,36 @@ async function check(file) {
   out.select = { clicked: other, detail: await detail(page), changed: changed(beforeSelect, await pixels(page)) };
 
   out.errors = log.errors;
+  // Paging: the page of rows shown, the next page, and a design carried as a row only.
+  const pager = async () => page.evaluate(() => ({
+    info: document.getElementById('page-info').textContent,
+    page: window.foldsynthReport.page,
+    pages: window.foldsynthReport.pages,
+    rows: Array.from(document.querySelectorAll('#design-table tbody tr')).map((r) => r.dataset.id),
+    nextDisabled: document.getElementById('page-next').disabled,
+  }));
+  out.pager = { first: await pager() };
+  if (!out.pager.first.nextDisabled) {
+    await page.click('#page-next');
+    out.pager.next = await pager();
+  }
+  const rowOnly = await page.evaluate(() => {
+    const data = JSON.parse(document.getElementById('foldsynth-data').textContent);
+    const full = new Set(data.designs.map((d) => d.id));
+    const shown = Array.from(document.querySelectorAll('#design-table tbody tr')).map((r) => r.dataset.id);
+    return shown.find((id) => !full.has(id)) || null;
+  });
+  if (rowOnly) {
+    await page.click(`#design-table tbody tr[data-id="${rowOnly}"]`);
+    out.rowOnly = await page.evaluate(() => ({
+      selected: window.foldsynthReport.selected,
+      title: document.getElementById('detail-title').textContent,
+      files: document.getElementById('detail-files').textContent,
+      viewsHidden: document.querySelector('#detail .views').hidden,
+      facts: document.querySelectorAll('#detail-facts tr').length,
+    }));
+  }
+
   out.warnings = log.warnings;
   out.requests = requests.filter((u) => !u.startsWith('file://' + path.resolve(file)) && !u.startsWith('data:'));
   await page.close();

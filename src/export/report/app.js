@@ -8,48 +8,138 @@
   const data = JSON.parse(document.getElementById('foldsynth-data').textContent);
   const table = document.getElementById('design-table');
   if (!table) return; // no feasible designs: nothing to show
+  // Designs carried in full (card, geometry); every design is a row of the table.
   const byId = new Map(data.designs.map((d) => [d.id, d]));
   const tbody = table.tBodies[0];
-  const rows = Array.from(tbody.rows);
   const heads = Array.from(table.tHead.rows[0].cells);
-  const state = { selected: null, frame: 0, playing: false, webgl: false, sort: null };
+  const cols = heads.map((h) => ({ key: h.dataset.key, numeric: h.dataset.numeric === 'true', format: h.dataset.format }));
+  const colIndex = new Map(cols.map((c, i) => [c.key, i]));
+  // One entry per design: its values in column order, its search order, its <tr> once drawn.
+  const rows = data.rows.map((v, i) => ({ id: String(v[0]), v: v, order: i, tr: null }));
+  const rowById = new Map(rows.map((r) => [r.id, r]));
+  const pageSize = data.page_size || 100;
+  const state = { selected: null, frame: 0, playing: false, webgl: false, sort: null, page: 0, view: rows, filters: [] };
   // Read-only view of the page's state, for people poking around in the console.
   window.foldsynthReport = {
     get selected() { return state.selected; },
     get frame() { return state.frame; },
     get webgl() { return state.webgl; },
     get sort() { return state.sort; },
+    get page() { return state.page; },
+    get pages() { return pages(); },
+    get shown() { return state.view.length; },
     get objects() { return view && view.names ? view.names() : []; },
   };
 
-  // ---- table: sorting -------------------------------------------------------------------
-  function sortValue(row, key, numeric) {
-    const v = row.querySelector('td[data-key="' + key + '"]').dataset.v;
-    if (v === '') return null;
-    return numeric ? Number(v) : v;
+  // ---- table: cells -----------------------------------------------------------------------
+  // The text of a value as src/export/report/mod.rs writes it (Column::format).
+  function cellText(x, format) {
+    if (x === null || x === undefined) return '–';
+    if (format === 'vertex') return 'v' + x;
+    if (format === 'exp2') return x.toExponential(2).replace('e+', 'e');
+    if (format === 'num') {
+      if (x === 0) return '0';
+      const a = Math.abs(x);
+      if (a >= 1e-3 && a < 1e4) return x.toFixed(Math.max(0, 3 - Math.floor(Math.log10(a))));
+      return x.toExponential(3).replace('e+', 'e');
+    }
+    return String(x);
   }
 
+  // A margin's tooltip, from the card of a design carried in full.
+  function cellTitle(r, key) {
+    const d = byId.get(r.id);
+    const m = d && d.robustness ? d.robustness[key] : null;
+    if (!m || typeof m.value !== 'number') return null;
+    let t = m.value + ' (setting ' + (typeof m.setting === 'number' ? m.setting : '–');
+    if (typeof m.t === 'number') t += ', at t = ' + m.t.toFixed(4);
+    if (m.where) t += ', ' + (Array.isArray(m.where) ? m.where.join(', ') : m.where);
+    return t + ')';
+  }
+
+  function rowElement(r) {
+    if (r.tr) return r.tr;
+    const tr = document.createElement('tr');
+    tr.dataset.id = r.id;
+    tr.tabIndex = 0;
+    cols.forEach((c, i) => {
+      const td = document.createElement('td');
+      const x = r.v[i];
+      td.dataset.key = c.key;
+      td.dataset.v = x === null || x === undefined ? '' : String(x);
+      if (c.numeric) td.className = 'num';
+      td.textContent = cellText(x, c.format);
+      const title = c.format === 'num' && c.key !== 'area' && c.key !== 'score' ? cellTitle(r, c.key) : null;
+      if (title) td.title = title;
+      tr.appendChild(td);
+    });
+    tr.addEventListener('click', () => select(r.id));
+    tr.addEventListener('keydown', (e) => {
+      if (e.key === 'Enter') select(r.id);
+    });
+    r.tr = tr;
+    return tr;
+  }
+
+  // ---- table: the page of rows shown --------------------------------------------------------
+  const shownEl = document.getElementById('shown');
+  const pageInfo = document.getElementById('page-info');
+  const prevBtn = document.getElementById('page-prev');
+  const nextBtn = document.getElementById('page-next');
+  function pages() {
+    return Math.max(1, Math.ceil(state.view.length / pageSize));
+  }
+
+  function render() {
+    state.page = Math.min(Math.max(0, state.page), pages() - 1);
+    const first = state.page * pageSize;
+    const slice = state.view.slice(first, first + pageSize);
+    tbody.replaceChildren(...slice.map(rowElement));
+    for (const r of slice) r.tr.classList.toggle('selected', r.id === state.selected);
+    shownEl.textContent = String(state.view.length);
+    if (pageInfo) {
+      pageInfo.textContent = state.view.length
+        ? 'rows ' + (first + 1) + '–' + (first + slice.length) + ' of ' + state.view.length + ' (page ' + (state.page + 1) + ' of ' + pages() + ')'
+        : 'no row matches';
+    }
+    if (prevBtn) prevBtn.disabled = state.page === 0;
+    if (nextBtn) nextBtn.disabled = state.page >= pages() - 1;
+  }
+  if (prevBtn) prevBtn.addEventListener('click', () => { state.page -= 1; render(); });
+  if (nextBtn) nextBtn.addEventListener('click', () => { state.page += 1; render(); });
+
+  // ---- table: sorting -------------------------------------------------------------------
   // Stable: equal values keep the search's order; missing values go last either way.
+  function compare(a, b, k, numeric, dir) {
+    const x = a.v[k];
+    const y = b.v[k];
+    const nx = x === null || x === undefined;
+    const ny = y === null || y === undefined;
+    if (nx || ny) {
+      if (nx && ny) return a.order - b.order;
+      return nx ? 1 : -1;
+    }
+    const c = numeric ? x - y : String(x).localeCompare(String(y), 'en', { numeric: true });
+    return c !== 0 ? dir * c : a.order - b.order;
+  }
+
+  function sorted(list) {
+    if (!state.sort) return list.slice().sort((a, b) => a.order - b.order);
+    const k = colIndex.get(state.sort.key);
+    const numeric = cols[k].numeric;
+    return list.slice().sort((a, b) => compare(a, b, k, numeric, state.sort.dir));
+  }
+
   function sortBy(key, dir) {
     const th = heads.find((h) => h.dataset.key === key);
     if (!th) return;
-    const numeric = th.dataset.numeric === 'true';
-    const keyed = rows.map((r, i) => [sortValue(r, key, numeric), i, r]);
-    keyed.sort((a, b) => {
-      if (a[0] === null || b[0] === null) {
-        if (a[0] === b[0]) return a[1] - b[1];
-        return a[0] === null ? 1 : -1;
-      }
-      const c = numeric
-        ? a[0] - b[0]
-        : a[0].localeCompare(b[0], 'en', { numeric: true });
-      return c !== 0 ? dir * c : a[1] - b[1];
-    });
-    for (const k of keyed) tbody.appendChild(k[2]);
     for (const h of heads) {
       h.setAttribute('aria-sort', h === th ? (dir > 0 ? 'ascending' : 'descending') : 'none');
     }
     state.sort = { key: key, dir: dir };
+    state.view = sorted(state.view);
+    state.page = 0;
+    render();
   }
 
   for (const th of heads) {
@@ -68,15 +158,14 @@
 
   // ---- table: filtering -----------------------------------------------------------------
   const filters = Array.from(table.tHead.querySelectorAll('[data-filter]'));
-  const shownEl = document.getElementById('shown');
 
-  function passes(row, f) {
-    const td = row.querySelector('td[data-key="' + f.key + '"]');
-    if (f.kind === 'text') return td.textContent.toLowerCase().includes(f.value.toLowerCase());
-    if (f.kind === 'choice') return td.textContent === f.value;
-    if (td.dataset.v === '') return false;
-    const v = Number(td.dataset.v);
-    return f.kind === 'max' ? v <= f.limit : v >= f.limit;
+  function passes(r, f) {
+    const k = colIndex.get(f.key);
+    const x = r.v[k];
+    if (f.kind === 'text') return cellText(x, cols[k].format).toLowerCase().includes(f.value.toLowerCase());
+    if (f.kind === 'choice') return cellText(x, cols[k].format) === f.value;
+    if (x === null || x === undefined) return false;
+    return f.kind === 'max' ? x <= f.limit : x >= f.limit;
   }
 
   function applyFilters() {
@@ -96,13 +185,10 @@
       }
       active.push(f);
     }
-    let shown = 0;
-    for (const r of rows) {
-      const ok = active.every((f) => passes(r, f));
-      r.hidden = !ok;
-      if (ok) shown += 1;
-    }
-    shownEl.textContent = String(shown);
+    state.filters = active;
+    state.view = sorted(rows.filter((r) => active.every((f) => passes(r, f))));
+    state.page = 0;
+    render();
   }
   for (const el of filters) {
     el.addEventListener('input', applyFilters);
@@ -111,13 +197,6 @@
   }
 
   // ---- the selected design ----------------------------------------------------------------
-  for (const r of rows) {
-    r.addEventListener('click', () => select(r.dataset.id));
-    r.addEventListener('keydown', (e) => {
-      if (e.key === 'Enter') select(r.dataset.id);
-    });
-  }
-
   function el(tag, attrs, text) {
     const e = document.createElement(tag);
     for (const k in attrs || {}) e.setAttribute(k, attrs[k]);
@@ -125,11 +204,20 @@
     return e;
   }
 
+  const views = document.querySelector('#detail .views');
   function select(id) {
-    const d = byId.get(id);
-    if (!d) return;
+    const r = rowById.get(id);
+    if (!r) return;
     state.selected = id;
-    for (const r of rows) r.classList.toggle('selected', r.dataset.id === id);
+    for (const x of state.view.slice(state.page * pageSize, (state.page + 1) * pageSize)) {
+      if (x.tr) x.tr.classList.toggle('selected', x.id === id);
+    }
+    const d = byId.get(id);
+    if (views) views.hidden = !d;
+    if (!d) {
+      selectRowOnly(r);
+      return;
+    }
     const parts = [d.id, d.sequence];
     if (d.candidate !== null) parts.push('candidate ' + d.candidate);
     if (d.modes !== '–') parts.push(d.modes);
@@ -155,6 +243,34 @@
     drawCreasePattern(d);
     if (view) view.show(d);
     setFrame(d.geometry.frames.length ? d.geometry.frames.length - 1 : 0);
+  }
+
+  // A design the page carries as a row only: its row's values, and the command that draws
+  // it (its design JSON is beside the report).
+  function selectRowOnly(r) {
+    const text = (key) => {
+      const k = colIndex.get(key);
+      return k === undefined ? '–' : cellText(r.v[k], cols[k].format);
+    };
+    const parts = [r.id, text('sequence')];
+    if (colIndex.has('candidate') && r.v[colIndex.get('candidate')] !== null) parts.push('candidate ' + text('candidate'));
+    document.getElementById('detail-title').textContent = parts.join(' — ');
+    const facts = document.getElementById('detail-facts').tBodies[0];
+    facts.replaceChildren();
+    cols.forEach((c, k) => {
+      const tr = el('tr');
+      tr.appendChild(el('th', {}, heads[k].textContent));
+      tr.appendChild(el('td', {}, cellText(r.v[k], c.format)));
+      facts.appendChild(tr);
+    });
+    billTable(null);
+    const files = document.getElementById('detail-files');
+    files.replaceChildren();
+    files.appendChild(document.createTextNode('This page carries the ' + data.designs.length + ' most robust designs in full (--report-designs). To view this one: '));
+    files.appendChild(el('code', {}, 'foldsynth export designs/' + r.id + '.json --format all --out designs/' + r.id));
+    files.appendChild(document.createTextNode(' (beside this report), or open '));
+    files.appendChild(el('a', { href: 'designs/' + encodeURIComponent(r.id) + '.json' }, 'its design JSON'));
+    files.appendChild(document.createTextNode('.'));
   }
 
   // The bill of the build of a thick design: the setting, every crease as a hinge, every
@@ -650,7 +766,10 @@
   });
 
   // Most robust first when the records carry robustness; otherwise the search's order.
-  if (heads.some((h) => h.dataset.key === 'score')) sortBy('score', -1);
+  if (heads.some((h) => h.dataset.key === 'score')) state.sort = { key: 'score', dir: -1 };
+  if (state.sort) sortBy(state.sort.key, state.sort.dir);
   applyFilters();
-  select(tbody.rows[0].dataset.id);
+  // The first design carried in full (the most robust), else the first row.
+  const first = state.view.find((r) => byId.has(r.id)) || state.view[0];
+  if (first) select(first.id);
 })();

@@ -139,6 +139,12 @@ pub struct ReportDesign {
     /// Its thick panels and the bill of the build ([`thick_json`]), for a task with
     /// `[fabrication]`: drawn in the 3D view, the bill as a table.
     pub thick: Option<Value>,
+    /// Shown in full: its card, 3D view and crease pattern are in the page. `false`: a row
+    /// of the table only (a large run's page carries the most robust designs in full and
+    /// every design as a row, so it stays one file a browser opens in seconds); `pattern`,
+    /// `geometry`, `facts` and `files` are then not read, and selecting the row says how
+    /// to draw the design.
+    pub in_full: bool,
 }
 
 /// Everything the report shows.
@@ -155,6 +161,9 @@ pub struct ReportInput {
     /// The feasible designs, in the search's order.
     pub designs: Vec<ReportDesign>,
 }
+
+/// Rows of the design table the page draws at a time.
+pub const PAGE_ROWS: usize = 100;
 
 /// The robustness margins of the shared contract, in column order, with their labels.
 pub const MARGINS: [(&str, &str); 5] = [
@@ -245,16 +254,6 @@ pub fn geometry_text(p: &Pattern) -> Result<String> {
 fn margin<'a>(rob: Option<&'a Value>, key: &str) -> Option<&'a Value> {
     rob?.get(key)
         .filter(|m| m.get("value").is_some_and(Value::is_f64))
-}
-
-/// Plain text for a JSON value: strings without quotes, arrays joined by ", ".
-fn plain(v: &Value) -> String {
-    match v {
-        Value::String(s) => s.clone(),
-        Value::Null => "–".into(),
-        Value::Array(a) => a.iter().map(plain).collect::<Vec<_>>().join(", "),
-        other => other.to_string(),
-    }
 }
 
 /// A number for a table cell: 4 significant digits.
@@ -373,6 +372,10 @@ struct Column {
     label: String,
     filter: Filter,
     numeric: bool,
+    /// How the page writes a value as text: `text` as it is, `int`, `vertex` (`v7`),
+    /// `exp2` (2 decimals in exponent form, as Ω*), `num` (4 significant digits, as
+    /// [`num`]); null is `–` in every format. The cells made here use the same rules.
+    format: &'static str,
 }
 
 #[derive(Clone, Copy, PartialEq)]
@@ -387,40 +390,46 @@ enum Filter {
     AtLeast,
 }
 
-/// One cell: shown text, sort value (number or text), tooltip.
+/// One cell: shown text (the filters' choices), and the value it sorts by (number or
+/// text), which is what the page's data carries.
 struct Cell {
     text: String,
     sort: Value,
-    title: Option<String>,
 }
 
 fn cell(text: impl Into<String>, sort: Value) -> Cell {
     Cell {
         text: text.into(),
         sort,
-        title: None,
     }
 }
 
 /// Columns of the table: the margins only where some design has them.
 fn columns(designs: &[ReportDesign]) -> Vec<Column> {
-    let col = |key, label: &str, filter, numeric| Column {
+    let col = |key, label: &str, filter, numeric, format| Column {
         key,
         label: label.to_string(),
         filter,
         numeric,
+        format,
     };
     let mut cols = vec![
-        col("id", "id", Filter::Text, false),
-        col("sequence", "rule sequence", Filter::Text, false),
-        col("level", "level", Filter::Choice, true),
-        col("candidate", "cand.", Filter::Choice, true),
-        col("gripping", "gripping vertex", Filter::Choice, false),
-        col("modes", "modes", Filter::Choice, false),
-        col("objective", "Ω*", Filter::AtMost, true),
+        col("id", "id", Filter::Text, false, "text"),
+        col("sequence", "rule sequence", Filter::Text, false, "text"),
+        col("level", "level", Filter::Choice, true, "int"),
+        col("candidate", "cand.", Filter::Choice, true, "int"),
+        col(
+            "gripping",
+            "gripping vertex",
+            Filter::Choice,
+            false,
+            "vertex",
+        ),
+        col("modes", "modes", Filter::Choice, false, "text"),
+        col("objective", "Ω*", Filter::AtMost, true, "exp2"),
     ];
     if designs.iter().any(|d| d.area.is_some()) {
-        cols.push(col("area", "area", Filter::AtLeast, true));
+        cols.push(col("area", "area", Filter::AtLeast, true, "num"));
     }
     let robust = |key: &str| {
         designs
@@ -433,11 +442,17 @@ fn columns(designs: &[ReportDesign]) -> Vec<Column> {
             .and_then(|r| r.get("score"))
             .is_some_and(Value::is_f64)
     }) {
-        cols.push(col("score", "robustness score", Filter::AtLeast, true));
+        cols.push(col(
+            "score",
+            "robustness score",
+            Filter::AtLeast,
+            true,
+            "num",
+        ));
     }
     for (key, label) in MARGINS {
         if robust(key) {
-            cols.push(col(key, label, Filter::AtLeast, true));
+            cols.push(col(key, label, Filter::AtLeast, true, "num"));
         }
     }
     cols
@@ -476,33 +491,17 @@ fn cells(d: &ReportDesign, cols: &[Column]) -> Vec<Cell> {
                 Some(s) => cell(num(s), json!(s)),
                 None => cell("–", Value::Null),
             },
-            key => match margin(d.robustness.as_ref(), key) {
-                Some(mv) => {
-                    let v = mv["value"].as_f64().unwrap_or(f64::NAN);
-                    let mut c = cell(num(v), json!(v));
-                    let setting = mv.get("setting").and_then(Value::as_f64);
-                    let t = mv.get("t").and_then(Value::as_f64);
-                    let at = mv.get("where").map(plain).unwrap_or_default();
-                    c.title = Some(format!(
-                        "{v} (setting {}{}{})",
-                        setting.map_or("–".into(), |s| s.to_string()),
-                        t.map_or(String::new(), |t| format!(", at t = {t:.4}")),
-                        if at.is_empty() {
-                            String::new()
-                        } else {
-                            format!(", {at}")
-                        }
-                    ));
-                    c
-                }
+            key => match margin(d.robustness.as_ref(), key).and_then(|m| m["value"].as_f64()) {
+                Some(v) => cell(num(v), json!(v)),
                 None => cell("–", Value::Null),
             },
         })
         .collect()
 }
 
-/// The design table: header row, filter row, one row per design (`data-id`), each cell
-/// carrying the value it sorts and filters by (`data-v`).
+/// The design table's head: the header row (each column's key, whether it is numeric and
+/// how the page formats its values) and the filter row. The page draws the rows, a page of
+/// [`PAGE_ROWS`] at a time, from the values in the data (`rows`).
 fn design_table(designs: &[ReportDesign]) -> String {
     let cols = columns(designs);
     let rows: Vec<Vec<Cell>> = designs.iter().map(|d| cells(d, &cols)).collect();
@@ -510,9 +509,10 @@ fn design_table(designs: &[ReportDesign]) -> String {
     for c in &cols {
         let _ = write!(
             s,
-            "<th data-key=\"{}\" data-numeric=\"{}\" aria-sort=\"none\" tabindex=\"0\" title=\"sort by {}\">{}</th>",
+            "<th data-key=\"{}\" data-numeric=\"{}\" data-format=\"{}\" aria-sort=\"none\" tabindex=\"0\" title=\"sort by {}\">{}</th>",
             c.key,
             c.numeric,
+            c.format,
             xml_escape(&c.label),
             xml_escape(&c.label)
         );
@@ -569,29 +569,7 @@ fn design_table(designs: &[ReportDesign]) -> String {
             }
         }
     }
-    s += "</tr></thead><tbody>";
-    for (d, row) in designs.iter().zip(&rows) {
-        let _ = write!(s, "<tr data-id=\"{}\" tabindex=\"0\">", xml_escape(&d.id));
-        for (c, x) in cols.iter().zip(row) {
-            let _ = write!(
-                s,
-                "<td data-key=\"{}\" data-v=\"{}\"{}{}>{}</td>",
-                c.key,
-                xml_escape(&match &x.sort {
-                    Value::String(t) => t.clone(),
-                    Value::Null => String::new(),
-                    v => v.to_string(),
-                }),
-                if c.numeric { " class=\"num\"" } else { "" },
-                x.title
-                    .as_ref()
-                    .map_or(String::new(), |t| format!(" title=\"{}\"", xml_escape(t))),
-                xml_escape(&x.text)
-            );
-        }
-        s += "</tr>";
-    }
-    s += "</tbody></table>";
+    s += "</tr></thead><tbody></tbody></table>";
     s
 }
 
@@ -670,24 +648,37 @@ fn write_html(
     // `{"designs": […], "scenes": […]}`, one design at a time.
     s += "</main>\n<script type=\"application/json\" id=\"foldsynth-data\">{\"designs\":[";
     w.write_all(s.as_bytes()).map_err(io)?;
-    for (i, (d, &scene)) in input.designs.iter().zip(scene_of).enumerate() {
+    let in_full = input.designs.iter().filter(|d| d.in_full);
+    for (i, (d, &scene)) in in_full.zip(scene_of).enumerate() {
         if i > 0 {
             w.write_all(b",").map_err(io)?;
         }
         w.write_all(design_text(out_dir, d, scene)?.as_bytes())
             .map_err(io)?;
     }
+    // The table's rows: per design the value of each column (the page formats the text).
+    w.write_all(b"],\"rows\":[").map_err(io)?;
+    let cols = columns(&input.designs);
+    for (i, d) in input.designs.iter().enumerate() {
+        if i > 0 {
+            w.write_all(b",").map_err(io)?;
+        }
+        let row: Vec<Value> = cells(d, &cols).into_iter().map(|c| c.sort).collect();
+        w.write_all(script_json(&Value::Array(row)).as_bytes())
+            .map_err(io)?;
+    }
     write!(
         w,
-        "],\"scenes\":{}}}</script>\n<script>{THREE_JS}</script>\n<script>{APP_JS}</script>\n</body></html>\n",
+        "],\"page_size\":{PAGE_ROWS},\"scenes\":{}}}</script>\n<script>{THREE_JS}</script>\n<script>{APP_JS}</script>\n</body></html>\n",
         script_json(&json!(scenes))
     )
     .and_then(|()| w.flush())
     .map_err(io)
 }
 
-/// Every design's id unique and its metadata valid; the distinct scenes of the designs
-/// (usually one: a task's), each once with its meshes, and the index of each design's own.
+/// Every design's id unique and the metadata of those in full valid; the distinct scenes
+/// of those (usually one: a task's), each once with its meshes, and the index of each one's
+/// own (in the order of the designs in full).
 fn designs_scenes(input: &ReportInput) -> Result<(Vec<usize>, Vec<Value>)> {
     let mut ids = BTreeSet::new();
     let mut seen: Vec<&DesignMeta> = Vec::new();
@@ -699,6 +690,9 @@ fn designs_scenes(input: &ReportInput) -> Result<(Vec<usize>, Vec<Value>)> {
                 format!("designs[{i}].id"),
                 format!("{:?} appears twice; design ids must be unique", d.id),
             ));
+        }
+        if !d.in_full {
+            continue;
         }
         let invalid =
             |e: ExportError| ExportError::invalid(format!("design {}", d.id), e.to_string());
@@ -788,9 +782,20 @@ fn designs_section(designs: &[ReportDesign]) -> String {
     if designs.is_empty() {
         s += "<p>No design passed every check.</p>";
     } else {
-        s += "<p class=\"hint\">Click a column to sort (again to reverse); the second row filters. Click a row to view the design.</p>";
-        s += "<div class=\"split\"><div class=\"table-wrap\">";
+        s += "<p class=\"hint\">Click a column to sort (again to reverse); the second row filters. Click a row to view the design.";
+        let full = designs.iter().filter(|d| d.in_full).count();
+        if full < designs.len() {
+            let _ = write!(
+                s,
+                " This page carries the {full} most robust designs in full (<code>--report-designs</code>) and every design as a row; selecting any other gives the command that draws it."
+            );
+        }
+        s += "</p><div class=\"split\"><div class=\"table-wrap\">";
         s += &design_table(designs);
+        let _ = write!(
+            s,
+            "<div class=\"pager\"><button type=\"button\" id=\"page-prev\">previous</button> <span id=\"page-info\"></span> <button type=\"button\" id=\"page-next\">next</button> <span class=\"hint\">({PAGE_ROWS} rows a page)</span></div>"
+        );
         s += "</div><article class=\"card\" id=\"detail\"><h3 id=\"detail-title\"></h3>\
 <div class=\"views\"><figure class=\"view3d\"><div id=\"view3d\"><canvas id=\"canvas3d\" width=\"640\" height=\"480\"></canvas><p id=\"no-webgl\" hidden>The 3D view needs WebGL, which this browser does not offer; the crease pattern and figures below still apply.</p></div>\
 <div class=\"controls\"><button type=\"button\" id=\"play\">play</button><input type=\"range\" id=\"t-slider\" min=\"0\" max=\"1\" step=\"0.01\" value=\"1\" aria-label=\"driving parameter t\"><output id=\"t-value\"></output></div>\
