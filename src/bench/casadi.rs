@@ -99,15 +99,7 @@ impl CasadiPeer {
 /// Run the peer script for `job`: it builds and compiles the vertex and writes its
 /// harness into a temporary folder.
 fn setup(job: &CasadiJob<'_>) -> Result<Setup> {
-    let script = job.script.map(Path::to_path_buf).unwrap_or_else(|| {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("benches/peers/casadi_vertex.py")
-    });
-    if !script.exists() {
-        bail!(
-            "peer script {} not found (use --peer-script)",
-            script.display()
-        );
-    }
+    let script = super::peer_script(job.script, "casadi_vertex.py")?;
     let units: Vec<_> = job
         .spec
         .units
@@ -126,10 +118,7 @@ fn setup(job: &CasadiJob<'_>) -> Result<Setup> {
         "t": job.t,
         "millis": job.millis,
     });
-    let stamp = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos());
-    let dir = std::env::temp_dir().join(format!("foldsynth-casadi-{}-{stamp}", std::process::id()));
+    let dir = super::scratch_dir("casadi");
     let out = std::process::Command::new("python3")
         .arg(&script)
         .arg("--vertex-json")

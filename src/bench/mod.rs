@@ -9,6 +9,8 @@
 //! none of them.
 
 use crate::cpu_time::Stopwatch;
+use anyhow::{Result, bail};
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 pub mod casadi;
@@ -27,6 +29,32 @@ pub enum Peer {
     /// Symbolica: its canonical form, its derivatives, its optimized evaluator, SymJIT
     /// (needs the `symbolica` cargo feature).
     Symbolica,
+}
+
+/// A peer's Python script: `given`, or the crate's `benches/peers/<name>`; an error naming
+/// the path when it does not exist.
+pub fn peer_script(given: Option<&Path>, name: &str) -> Result<PathBuf> {
+    let script = given.map(Path::to_path_buf).unwrap_or_else(|| {
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("benches/peers")
+            .join(name)
+    });
+    if !script.exists() {
+        bail!(
+            "peer script {} not found (use --peer-script)",
+            script.display()
+        );
+    }
+    Ok(script)
+}
+
+/// A fresh path in the system's temporary folder for one peer run's files (not created):
+/// `foldsynth-<what>-<process id>-<nanoseconds>`.
+pub fn scratch_dir(what: &str) -> PathBuf {
+    let stamp = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_nanos());
+    std::env::temp_dir().join(format!("foldsynth-{what}-{}-{stamp}", std::process::id()))
 }
 
 /// Median nanoseconds per call of `f`, over batches filling about `budget`: CPU time of

@@ -22,7 +22,7 @@ use crate::task::Task;
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 use serde_json::json;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// What to compare.
 pub struct OptimizeBenchOptions<'a> {
@@ -337,19 +337,8 @@ fn median(v: &[f64]) -> f64 {
 
 /// Run the peer script on `job`; its results.
 fn run_peer(opts: &OptimizeBenchOptions<'_>, job: &serde_json::Value) -> Result<serde_json::Value> {
-    let script = opts.script.map(Path::to_path_buf).unwrap_or_else(|| {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("benches/peers/ipopt_optimize.py")
-    });
-    if !script.exists() {
-        bail!(
-            "peer script {} not found (use --peer-script)",
-            script.display()
-        );
-    }
-    let stamp = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_nanos());
-    let dir = std::env::temp_dir().join(format!("foldsynth-ipopt-{}-{stamp}", std::process::id()));
+    let script = super::peer_script(opts.script, "ipopt_optimize.py")?;
+    let dir = super::scratch_dir("ipopt");
     std::fs::create_dir_all(&dir).with_context(|| format!("{}", dir.display()))?;
     let (job_path, out_path) = (dir.join("job.json"), dir.join("out.json"));
     let result = std::fs::write(&job_path, job.to_string())
