@@ -227,6 +227,23 @@ fn bad_task_files_are_clear_errors() {
     }
 }
 
+/// The design ids of a summary's ranking, most robust first.
+fn ranking_ids(summary: &Value) -> Vec<String> {
+    summary["ranking"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["id"].as_str().unwrap().to_string())
+        .collect()
+}
+
+/// The data report.html embeds for its script.
+fn report_data(html: &str) -> Value {
+    let start = "<script type=\"application/json\" id=\"foldsynth-data\">";
+    let data = &html[html.find(start).unwrap() + start.len()..];
+    serde_json::from_str(&data[..data.find("</script>").unwrap()]).unwrap()
+}
+
 /// `--report-motions N`: the report draws the whole motion (33 frames) of the N most
 /// robust designs and, for the others, the folded form alone: the design's last frame, as
 /// its JSON has it (the page rounds to 1e-4).
@@ -238,17 +255,10 @@ fn the_report_draws_the_motion_of_the_most_robust_only() {
         &out,
         &["--no-export", "--seed", "1", "--report-motions", "3"],
     );
-    let ranking: Vec<String> = s["ranking"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|r| r["id"].as_str().unwrap().to_string())
-        .collect();
+    let ranking = ranking_ids(&s);
     assert!(ranking.len() > 3);
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
-    let start = "<script type=\"application/json\" id=\"foldsynth-data\">";
-    let data = &html[html.find(start).unwrap() + start.len()..];
-    let data: Value = serde_json::from_str(&data[..data.find("</script>").unwrap()]).unwrap();
+    let data = report_data(&html);
     let designs = data["designs"].as_array().unwrap();
     assert_eq!(designs.len(), ranking.len());
     for d in designs {
@@ -311,17 +321,10 @@ fn the_report_carries_the_most_robust_in_full_and_every_design_as_a_row() {
         &out,
         &["--no-export", "--seed", "1", "--report-designs", "5"],
     );
-    let ranking: Vec<String> = s["ranking"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|r| r["id"].as_str().unwrap().to_string())
-        .collect();
+    let ranking = ranking_ids(&s);
     assert!(ranking.len() > 5);
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
-    let start = "<script type=\"application/json\" id=\"foldsynth-data\">";
-    let data = &html[html.find(start).unwrap() + start.len()..];
-    let data: Value = serde_json::from_str(&data[..data.find("</script>").unwrap()]).unwrap();
+    let data = report_data(&html);
     let full: Vec<&str> = data["designs"]
         .as_array()
         .unwrap()

@@ -10,7 +10,7 @@ use super::plan::Plan;
 use super::progress::Progress;
 use super::readback::read_at;
 use super::record::AlternativeRecord;
-use super::report::report_design;
+use super::report::{report_design, row_design};
 use crate::check::robustness::RobustnessReport;
 use crate::export::report::{Fact, ReportDesign};
 use crate::export::{self, DesignMeta, ExportOptions};
@@ -93,11 +93,12 @@ pub(super) fn write_designs(
                 .map(|w| {
                     let files = what(w.rank);
                     let in_full = opts.report_designs.is_none_or(|n| w.rank <= n);
-                    let mut card = write_design(w, files, opts.report_motions, out_dir, progress)?;
-                    if !in_full {
-                        // A row of the table only: what its cells show, nothing more held.
-                        card = row_only(card);
-                    } else if files == Written::Fold {
+                    let shown = Shown {
+                        in_full,
+                        motion: opts.report_motions,
+                    };
+                    let mut card = write_design(w, files, shown, out_dir, progress)?;
+                    if in_full && files == Written::Fold {
                         card.facts.push(files_on_demand(&card.id, out_dir, opts));
                     }
                     Ok::<_, SearchError>(card)
@@ -107,48 +108,6 @@ pub(super) fn write_designs(
         cards.extend(written);
     }
     Ok(cards)
-}
-
-/// A card reduced to its row of the report's table (outside `--report-designs N`): the
-/// page does not carry its geometry, and memory holds only what the row shows.
-fn row_only(card: ReportDesign) -> ReportDesign {
-    let m = card.meta;
-    ReportDesign {
-        pattern: Pattern {
-            vertices: Vec::new(),
-            edges: Vec::new(),
-            faces: Vec::new(),
-            frames: Vec::new(),
-        },
-        geometry: None,
-        meta: DesignMeta {
-            task: m.task,
-            rule_sequence: m.rule_sequence,
-            modes: m.modes,
-            gripping_vertex: m.gripping_vertex,
-            objective: m.objective,
-            ..Default::default()
-        },
-        facts: Vec::new(),
-        files: None,
-        verify: None,
-        thick: None,
-        // The values the row shows (score and margins), not their settings and places.
-        robustness: card.robustness.map(|r| {
-            let keep = |v: &serde_json::Value| match v.get("value") {
-                Some(x) => json!({"value": x}),
-                None => v.clone(),
-            };
-            match r {
-                serde_json::Value::Object(o) => {
-                    serde_json::Value::Object(o.iter().map(|(k, v)| (k.clone(), keep(v))).collect())
-                }
-                other => other,
-            }
-        }),
-        in_full: false,
-        ..card
-    }
 }
 
 /// Which of its files a design gets besides its JSON.
@@ -296,12 +255,21 @@ fn shell_word(path: &Path) -> String {
     }
 }
 
+/// How the report shows a design.
+#[derive(Clone, Copy)]
+struct Shown {
+    /// In full (`--report-designs N`), or a row of its table only.
+    in_full: bool,
+    /// `--report-motions N`: the motion of the N most robust (`None`: of all).
+    motion: Option<usize>,
+}
+
 /// Write a design's `designs/<id>.json` and its `files` (the FOLD file verified); its
-/// card for the report.
+/// card for the report (its row only, without geometry, outside `--report-designs N`).
 fn write_design(
     w: DesignWork,
     files: Written,
-    report_motions: Option<usize>,
+    shown: Shown,
     out_dir: &OutputDir,
     progress: &Progress,
 ) -> Result<ReportDesign, SearchError> {
@@ -355,7 +323,11 @@ fn write_design(
         }
     };
     progress.inc(1);
+    if !shown.in_full {
+        return Ok(row_design(&w.rec, w.meta, path));
+    }
     // Outside the `REPORT_MOTIONS` most robust, the page draws the folded form alone.
+    let report_motions = shown.motion;
     let motion = report_motions.is_none_or(|n| w.rank <= n);
     let drawn = if motion {
         w.pattern

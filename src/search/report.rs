@@ -335,11 +335,7 @@ pub(super) fn report_design(
         geometry,
         meta,
         robustness: robustness(rec),
-        area: rec
-            .requirements
-            .as_ref()
-            .and_then(|r| r.area.as_ref())
-            .and_then(|a| a.value),
+        area: area(rec),
         facts,
         design_file: Some(design_file),
         files,
@@ -347,6 +343,62 @@ pub(super) fn report_design(
         thick: None,
         in_full: true,
     }
+}
+
+/// A design the report shows as a row of its table only (outside `--report-designs N`):
+/// what its cells show and its design JSON, no geometry (memory holds this for each).
+pub(super) fn row_design(
+    rec: &AlternativeRecord,
+    meta: DesignMeta,
+    design_file: PathBuf,
+) -> ReportDesign {
+    // The values the row shows (score and margins), not their settings and places.
+    let value_only = |v: &serde_json::Value| match v.get("value") {
+        Some(x) => serde_json::json!({ "value": x }),
+        None => v.clone(),
+    };
+    let robustness = robustness(rec).map(|r| match r {
+        serde_json::Value::Object(o) => {
+            serde_json::Value::Object(o.iter().map(|(k, v)| (k.clone(), value_only(v))).collect())
+        }
+        other => other,
+    });
+    ReportDesign {
+        id: rec.id(),
+        level: rec.level,
+        candidate: Some(rec.candidate),
+        pattern: Pattern {
+            vertices: Vec::new(),
+            edges: Vec::new(),
+            faces: Vec::new(),
+            frames: Vec::new(),
+        },
+        geometry: None,
+        meta: DesignMeta {
+            task: meta.task,
+            rule_sequence: meta.rule_sequence,
+            modes: meta.modes,
+            gripping_vertex: meta.gripping_vertex,
+            objective: meta.objective,
+            ..Default::default()
+        },
+        robustness,
+        area: area(rec),
+        facts: Vec::new(),
+        design_file: Some(design_file),
+        files: None,
+        verify: None,
+        thick: None,
+        in_full: false,
+    }
+}
+
+/// The area of an area task as the check measured it.
+fn area(rec: &AlternativeRecord) -> Option<f64> {
+    rec.requirements
+        .as_ref()
+        .and_then(|r| r.area.as_ref())
+        .and_then(|a| a.value)
 }
 
 /// The report's content.
