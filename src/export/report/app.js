@@ -32,6 +32,14 @@
   };
 
   // ---- table: cells -----------------------------------------------------------------------
+  // The robustness margins (src/export/report/mod.rs MARGINS) and their labels.
+  const MARGIN_NAMES = {
+    rigid_margin: 'rigid margin',
+    self_clearance: 'self clearance',
+    arm_clearance: 'arm clearance',
+    obstacle_clearance: 'obstacle clearance',
+    min_feature: 'min feature',
+  };
   // The text of a value as src/export/report/mod.rs writes it (Column::format).
   function cellText(x, format) {
     if (x === null || x === undefined) return '–';
@@ -69,7 +77,7 @@
       td.dataset.v = x === null || x === undefined ? '' : String(x);
       if (c.numeric) td.className = 'num';
       td.textContent = cellText(x, c.format);
-      const title = c.format === 'num' && c.key !== 'area' && c.key !== 'score' ? cellTitle(r, c.key) : null;
+      const title = c.key in MARGIN_NAMES ? cellTitle(r, c.key) : null;
       if (title) td.title = title;
       tr.appendChild(td);
     });
@@ -300,13 +308,7 @@
   function robustnessFacts(r) {
     const out = [];
     if (typeof r.score === 'number') out.push(['robustness score', fmt(r.score)]);
-    const names = {
-      rigid_margin: 'rigid margin',
-      self_clearance: 'self clearance',
-      arm_clearance: 'arm clearance',
-      obstacle_clearance: 'obstacle clearance',
-      min_feature: 'min feature',
-    };
+    const names = MARGIN_NAMES;
     for (const key in names) {
       const m = r[key];
       if (!m || typeof m.value !== 'number') continue;
