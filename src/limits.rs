@@ -36,6 +36,8 @@ pub const COPIES_MAX: usize = 12;
 pub const MESH_TRIANGLES_TOTAL_MAX: usize = 100_000;
 /// Most worker threads (`--jobs`).
 pub const JOBS_MAX: usize = 256;
+/// The largest CPU budget of a guided search: a year of one core's time.
+pub const BUDGET_CPU_MAX: f64 = 3.2e7;
 /// Most folding steps of the bar-and-hinge simulation (`--steps`, `motion.steps`).
 pub const STEPS_MAX: u64 = 100_000;
 /// Most evaluations of `optimize-flasher --evals`.

@@ -3,7 +3,7 @@
 
 use crate::distribute::slurm::{self, SlurmOptions};
 use crate::limits;
-use crate::search::SearchOptions;
+use crate::search::{self, SearchOptions};
 use crate::task::Task;
 use anyhow::{Context, Result};
 use std::path::PathBuf;
@@ -53,6 +53,13 @@ pub struct SlurmArgs {
     /// Optimize without the robustness block and only check afterwards (as in the thesis).
     #[arg(long)]
     pub post_check_only: bool,
+    /// `exhaustive` (default) or `guided`: the shards share the models a guided search
+    /// of `--budget-alternatives` evaluates (see `synthesize --strategy`).
+    #[arg(long, default_value_t = search::Strategy::Exhaustive, value_name = "STRATEGY")]
+    pub strategy: search::Strategy,
+    /// With `--strategy guided`: the alternatives the shards optimize together.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub budget_alternatives: Option<u64>,
 }
 
 /// Run `foldsynth slurm`.
@@ -81,6 +88,15 @@ pub fn run(args: SlurmArgs) -> Result<()> {
             export: !args.no_export,
             rules: args.rules,
             post_check_only: args.post_check_only,
+            guided: match args.strategy {
+                search::Strategy::Guided => Some(args.budget_alternatives),
+                search::Strategy::Exhaustive if args.budget_alternatives.is_some() => {
+                    anyhow::bail!(
+                        "--budget-alternatives is for the guided search: add --strategy guided"
+                    )
+                }
+                search::Strategy::Exhaustive => None,
+            },
             foldsynth,
         },
     )?;

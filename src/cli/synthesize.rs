@@ -66,6 +66,23 @@ pub struct SynthesizeArgs {
     /// the whole run of all N). Resumable with --resume like a whole run.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<ShardSpec>,
+    /// How to choose what to optimize: `exhaustive` (every alternative, the default) or
+    /// `guided` (the most promising models first, until a budget is spent; see
+    /// docs/guided-search.md).
+    #[arg(long, default_value_t = search::Strategy::Exhaustive, value_name = "STRATEGY")]
+    pub strategy: search::Strategy,
+    /// With `--strategy guided`: optimize this many alternatives (rounded up to whole
+    /// models); the same seed and budget give the same records.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    pub budget_alternatives: Option<u64>,
+    /// With `--strategy guided`: start no model after this many CPU seconds (all threads).
+    #[arg(long, value_name = "SECONDS")]
+    pub budget_cpu: Option<f64>,
+    /// With `--strategy guided`: no warm starts from the parents' optima (then an
+    /// unlimited guided run has exactly the exhaustive run's records; shards never use
+    /// them, since a parent may be in another shard).
+    #[arg(long)]
+    pub no_warm_starts: bool,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -104,6 +121,12 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         progress: true,
         rules: args.rules,
         post_check_only: args.post_check_only,
+        strategy: args.strategy,
+        budget: search::Budget {
+            alternatives: args.budget_alternatives,
+            cpu_s: args.budget_cpu,
+        },
+        warm_starts: !args.no_warm_starts,
         on_progress: None,
     };
     if let Some(spec) = args.shard {

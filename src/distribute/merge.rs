@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::DistributeError;
-use super::shard::assign;
+use super::shard::{deal, searched};
 use crate::grammar::Rules;
 use crate::search::output::{OutputDir, RECORDS, RunSettings, SETTINGS, ShardSpec};
 use crate::search::plan::Done;
@@ -309,14 +309,20 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
     let start = Instant::now();
     let shards = read_shards(dirs, &opts.out)?;
     let (task, _) = read_task(&shards)?;
+    let guided = shards[0].settings.guided;
     let settings = RunSettings {
         shard: None,
+        guided: None,
         ..shards[0].settings.clone()
     };
-    let search_opts = search_options(&settings, &shards[0], opts)?;
+    let mut search_opts = search_options(&settings, &shards[0], opts)?;
+    if let Some(selection) = guided {
+        search_opts.strategy = search::Strategy::Guided;
+        search_opts.budget.alternatives = selection.alternatives;
+    }
     let n_max = search::check_search(&task, &search_opts)?;
     let plan = search::plan(&task, n_max, search_opts.rules)?;
-    let deal = assign(&plan, shards[0].spec.count);
+    let deal = deal(&plan, &searched(&plan, guided), shards[0].spec.count);
     // Every shard complete, every record in its place, before anything is written.
     let (failed, compile_s) = check_complete(&plan, &shards, &deal, &settings)?;
 
@@ -403,6 +409,9 @@ fn search_options(
         progress: false,
         rules,
         post_check_only: settings.post_check_only,
+        strategy: search::Strategy::Exhaustive,
+        budget: search::Budget::default(),
+        warm_starts: false,
         on_progress: None,
     })
 }

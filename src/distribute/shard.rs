@@ -18,7 +18,21 @@ use crate::task::digest_with_meshes;
 
 /// The units of each of `count` shards (shard k at index k − 1), each in record order.
 pub fn assign(plan: &Plan, count: usize) -> Vec<Vec<usize>> {
-    let mut order: Vec<usize> = (0..plan.units.len()).collect();
+    deal(plan, &(0..plan.units.len()).collect::<Vec<_>>(), count)
+}
+
+/// The units a search of `plan` evaluates: all of them, or those a guided search of
+/// budget `guided` selects (see [`search::guide`]).
+pub fn searched(plan: &Plan, guided: Option<search::Selection>) -> Vec<usize> {
+    match guided {
+        None => (0..plan.units.len()).collect(),
+        Some(b) => search::guide::select(plan, b.alternatives),
+    }
+}
+
+/// As [`assign`] for the units `units` of `plan` only (a guided search's selection).
+pub fn deal(plan: &Plan, units: &[usize], count: usize) -> Vec<Vec<usize>> {
+    let mut order = units.to_vec();
     order.sort_by_key(|&u| (Reverse(plan.units[u].cost), u));
     // Least loaded first; equal loads: the lowest shard number.
     let mut heap: BinaryHeap<Reverse<(u64, usize)>> = (0..count).map(|k| Reverse((0, k))).collect();
@@ -58,8 +72,22 @@ pub fn run(
         ));
     }
     let n_max = search::check_search(task, opts)?;
+    if opts.budget.cpu_s.is_some() {
+        return Err(DistributeError::input(
+            "--budget-cpu",
+            "a shard's share must be the same on every machine: give a guided search in shards a budget of alternatives (--budget-alternatives), not of CPU seconds",
+        ));
+    }
     let plan = search::plan(task, n_max, opts.rules)?;
-    let units = share(&plan, spec);
+    let guided = (opts.strategy == search::Strategy::Guided).then_some(search::Selection {
+        alternatives: opts.budget.alternatives,
+    });
+    let units = deal(&plan, &searched(&plan, guided), spec.count).swap_remove(spec.index - 1);
+    // A parent may be in another shard: shards start from no parent's optimum.
+    let opts = SearchOptions {
+        warm_starts: false,
+        ..opts.clone()
+    };
     Ok(search::run_shard(
         task,
         &plan,
@@ -68,6 +96,6 @@ pub fn run(
             units: &units,
             task_text,
         },
-        opts,
+        &opts,
     )?)
 }

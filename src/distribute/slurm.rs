@@ -43,6 +43,10 @@ pub struct SlurmOptions {
     pub rules: crate::grammar::Rules,
     /// Optimize without the robustness block (`--post-check-only`).
     pub post_check_only: bool,
+    /// A guided search (`--strategy guided`) of this many alternatives (`Some(None)`:
+    /// every model, in the guided order); `None`: the exhaustive search. Each shard
+    /// evaluates its deal of the budget's models.
+    pub guided: Option<Option<u64>>,
     /// The foldsynth binary the jobs run.
     pub foldsynth: PathBuf,
 }
@@ -250,6 +254,12 @@ fn search_settings(opts: &SlurmOptions) -> String {
     }
     if opts.post_check_only {
         settings += " --post-check-only";
+    }
+    if let Some(budget) = opts.guided {
+        settings += " --strategy guided";
+        if let Some(n) = budget {
+            settings += &format!(" --budget-alternatives {n}");
+        }
     }
     settings
 }

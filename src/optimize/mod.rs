@@ -167,6 +167,12 @@ pub struct Options {
     /// (or its outer iterations end) rather than returning at its first point that meets
     /// the target, and [`Options::give_up_after`] does not apply. Off by default.
     pub all_starts: bool,
+    /// Starting points to try after the quasi-random ones when none of those succeeded
+    /// (a guided search's warm starts from a parent's optimum, issue 34): points in the
+    /// variables' own units, moved 2 % inside their bounds. They run even when the
+    /// quasi-random starts gave up, and never share phase A with other problems.
+    #[serde(skip)]
+    pub warm_starts: Vec<Vec<f64>>,
 }
 
 impl Default for Options {
@@ -187,6 +193,7 @@ impl Default for Options {
             give_up_after: 10,
             give_up_factor: 4.0,
             all_starts: false,
+            warm_starts: Vec::new(),
         }
     }
 }
@@ -218,6 +225,9 @@ pub struct Solution {
     pub starts_run: usize,
     /// Problem evaluations spent.
     pub evaluations: usize,
+    /// It came from one of [`Options::warm_starts`] (its `start` counts on from the
+    /// quasi-random starts).
+    pub warm: bool,
 }
 
 /// The i-th radical inverse in base `b` (Halton).
@@ -270,6 +280,17 @@ impl Transform {
             .map(|(i, u)| {
                 let (l, h) = (self.lo[i], self.hi[i]);
                 l + (h - l) * (0.02 + 0.96 * u)
+            })
+            .collect()
+    }
+    /// `x` moved inside its bounds as far as [`Transform::start`] keeps its points.
+    fn inside(&self, x: &[f64]) -> Vec<f64> {
+        x.iter()
+            .enumerate()
+            .map(|(i, &x)| {
+                let (l, h) = (self.lo[i], self.hi[i]);
+                let u = if h > l { (x - l) / (h - l) } else { 0.5 };
+                l + (h - l) * (0.02 + 0.96 * u.clamp(0.0, 1.0))
             })
             .collect()
     }
@@ -660,14 +681,22 @@ pub fn minimize_shared<P: Problem>(
     let counter = Cell::new(0usize);
     let mut evaluations = 0;
     let mut attempts = 0;
-    let points = quasi_random_points(n, opts.starts, opts.seed);
+    let fresh = quasi_random_points(n, opts.starts, opts.seed)
+        .into_iter()
+        .map(|u| (transform.start(&u), false));
+    let warm = opts.warm_starts.iter().map(|x| (transform.inside(x), true));
     // Best feasible phase-A objective so far, for the give-up rule.
     let mut best_feasible_f = f64::INFINITY;
     let mut starts_run = 0;
     let mut replayed_evaluations = 0;
-    for (start, u) in points.iter().enumerate() {
-        starts_run = start + 1;
-        let x0 = transform.start(u);
+    let mut gave_up = false;
+    for (start, (x0, is_warm)) in fresh.chain(warm).enumerate() {
+        if gave_up && !is_warm {
+            continue;
+        }
+        starts_run += 1;
+        // Warm starts are this problem's own: no class shares them.
+        let shared = if is_warm { None } else { shared };
         let mut al = Lagrangian {
             problem,
             transform: &transform,
@@ -709,8 +738,9 @@ pub fn minimize_shared<P: Problem>(
             robust_violation,
             robust_attempts: 0,
             start,
-            starts_run: start + 1,
+            starts_run,
             evaluations,
+            warm: is_warm,
         };
         if best.as_ref().is_none_or(|b| candidate.better_than(b)) {
             best = Some(candidate);
@@ -719,13 +749,14 @@ pub fn minimize_shared<P: Problem>(
             None => met,
             Some(_) => met && robust_ok == Some(true),
         };
-        if (done && !opts.all_starts) || gives_up(opts, start + 1, best_feasible_f) {
+        if done && !opts.all_starts {
             break;
         }
+        gave_up = gave_up || (!is_warm && gives_up(opts, start + 1, best_feasible_f));
     }
     let mut best = best.expect("at least one start");
     let done = best.met_target && best.robust != Some(false) && !opts.all_starts;
-    best.starts_run = if done { best.start + 1 } else { starts_run };
+    best.starts_run = if done { best.starts_run } else { starts_run };
     best.evaluations = evaluations + counter.get() + replayed_evaluations;
     best.robust_attempts = attempts;
     best

@@ -72,12 +72,13 @@ pub(super) fn evaluate(
     graph: &CreaseGraph,
     opts: &SearchOptions,
     shared: &SharedStarts,
+    warm: Vec<Vec<f64>>,
 ) -> Result<AlternativeRecord, String> {
     let model = &p.model;
     let modes = alt.mode_signs();
     let key = alt.key();
     let t0 = Stopwatch::start();
-    let (sol, block_compile_s) = optimize_alternative(p, &modes, opts, shared)?;
+    let (sol, block_compile_s) = optimize_alternative(p, &modes, opts, shared, warm)?;
     let optimize_ms = t0.cpu_ms() - block_compile_s * 1e3;
     let full = model.full_vars(&sol.x);
     let omega = model.omega(&full, &modes);
@@ -100,6 +101,7 @@ fn optimize_alternative(
     modes: &[f64],
     opts: &SearchOptions,
     shared: &SharedStarts,
+    warm_starts: Vec<Vec<f64>>,
 ) -> Result<(Solution, f64), String> {
     let model = &p.model;
     let problem = ModelProblem::new(model, &p.compiled, modes);
@@ -113,6 +115,7 @@ fn optimize_alternative(
         } else {
             crate::model::cycle::MAX_OUTER
         },
+        warm_starts,
         ..Default::default()
     };
     let mut block_compile_s = 0.0;
@@ -184,6 +187,7 @@ fn optimized_record(
         short_of_margins: Vec::new(),
         variables,
         starts_run: sol.starts_run,
+        warm_start: sol.warm,
         evaluations: sol.evaluations,
         optimize_ms,
         check_ms: 0.0,

@@ -3,6 +3,7 @@
 //! `summary.json` last.
 
 use super::designs::write_designs;
+use super::guide::coverage;
 use super::options::{Evaluation, SearchError, SearchOptions};
 use super::output::{OutputDir, RECORDS};
 use super::parquet::write_results;
@@ -11,6 +12,7 @@ use super::progress::Progress;
 use super::readback::{read_at, tally_records};
 use super::record::{RankEntry, Summary, Tally, Timings};
 use super::report::write_report;
+use super::strategy::Budget;
 use crate::model::robust::RobustSpec;
 use crate::task::Task;
 use serde_json::json;
@@ -88,7 +90,8 @@ fn summarize(
         feasible: tally.feasible,
         rigid_at_tmax_only: tally.rigid_at_tmax_only,
         verification_failures: tally.verification_failures,
-        thesis: if plan.n_max == 3 {
+        // The thesis's counts are of the whole space, not of a guided run's budget.
+        thesis: if plan.n_max == 3 && opts.budget == Budget::default() {
             Summary::thesis_counts(&task.name)
         } else {
             None
@@ -118,6 +121,12 @@ fn summarize(
             c.graphs = plan.cyclic_graphs;
             c
         }),
+        coverage: Some(coverage(
+            plan,
+            opts.strategy,
+            opts.budget,
+            &tally.by_vertices,
+        )),
     }
 }
 

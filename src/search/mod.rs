@@ -26,6 +26,7 @@
 mod designs;
 mod evaluate;
 mod finish;
+pub mod guide;
 pub mod lock;
 mod measure;
 mod open;
@@ -39,6 +40,8 @@ mod record;
 mod report;
 mod run;
 mod schedule;
+pub mod strategy;
+mod warm;
 
 pub use designs::{model_meta, remeasure};
 pub use evaluate::prepare;
@@ -56,3 +59,4 @@ pub use readback::tally_records;
 pub use record::{AlternativeRecord, RankEntry, Summary, Tally, Timings, level_distribution};
 pub use run::{run, run_shard};
 pub use schedule::evaluate_units;
+pub use strategy::{Budget, Coverage, Selection, Strategy, VertexCoverage};

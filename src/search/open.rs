@@ -3,6 +3,7 @@
 
 use super::options::{SearchError, SearchOptions};
 use super::output::{OutputDir, RunSettings, SETTINGS, ShardSpec};
+use super::strategy::Strategy;
 use crate::grammar::Rules;
 use crate::task::Task;
 
@@ -24,6 +25,11 @@ pub fn settings(
         rules: (opts.rules != Rules::default()).then(|| opts.rules.names()),
         post_check_only: opts.post_check_only,
         shard,
+        guided: (shard.is_some() && opts.strategy == Strategy::Guided).then_some(
+            super::strategy::Selection {
+                alternatives: opts.budget.alternatives,
+            },
+        ),
     }
 }
 

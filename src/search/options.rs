@@ -5,6 +5,7 @@
 use super::output::{self, ShardSpec};
 use super::progress::ProgressHook;
 use super::record::Timings;
+use super::strategy::{Budget, Strategy};
 use crate::grammar::Rules;
 use crate::limits;
 use crate::model::ModelError;
@@ -55,6 +56,15 @@ pub struct SearchOptions {
     /// Today's behaviour before issue 12: optimize without the robustness block and only
     /// check afterwards (for side-by-side comparisons).
     pub post_check_only: bool,
+    /// Exhaustive (every alternative) or guided (the most promising models first, up to
+    /// `budget`; see [`guide`](super::guide)).
+    pub strategy: Strategy,
+    /// What a guided search may spend.
+    pub budget: Budget,
+    /// A guided search also starts an alternative whose quasi-random starts failed from
+    /// its parent's optimum, where the parent was optimized earlier in the run (off:
+    /// exactly the exhaustive search's records).
+    pub warm_starts: bool,
     /// Told of every step of the run's progress, and able to stop it (the Python
     /// package's progress callback and Ctrl-C); `None` for the CLI.
     pub on_progress: Option<ProgressHook>,
@@ -78,6 +88,9 @@ impl Default for SearchOptions {
             progress: true,
             rules: Rules::default(),
             post_check_only: false,
+            strategy: Strategy::Exhaustive,
+            budget: Budget::default(),
+            warm_starts: true,
             on_progress: None,
         }
     }
@@ -315,5 +328,28 @@ pub fn check_search(task: &Task, opts: &SearchOptions) -> Result<usize, SearchEr
     for (what, value, min, max) in counts {
         limits::check_count(what, value, min, max).map_err(|m| terr(&m))?;
     }
+    check_budget(opts).map_err(|m| terr(&m))?;
     Ok(n_max)
+}
+
+/// A budget belongs to a guided search and must be something to spend.
+fn check_budget(opts: &SearchOptions) -> Result<(), String> {
+    let b = opts.budget;
+    if opts.strategy == Strategy::Exhaustive && (b.alternatives.is_some() || b.cpu_s.is_some()) {
+        return Err(
+            "a budget (alternatives or CPU seconds) is for the guided search: add --strategy guided, or drop the budget to evaluate every alternative".into(),
+        );
+    }
+    if b.alternatives == Some(0) {
+        return Err("the budget of alternatives is 0; give at least 1".into());
+    }
+    if let Some(s) = b.cpu_s
+        && !(s.is_finite() && s > 0.0 && s <= limits::BUDGET_CPU_MAX)
+    {
+        return Err(format!(
+            "the CPU budget {s} s is not a number of seconds in (0, {}]",
+            limits::BUDGET_CPU_MAX
+        ));
+    }
+    Ok(())
 }

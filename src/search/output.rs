@@ -63,6 +63,11 @@ pub struct RunSettings {
     /// for a whole run (and for `merge`'s result, which is one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shard: Option<ShardSpec>,
+    /// A shard of a guided search: the budget its share was dealt from (the models a
+    /// guided run of this budget evaluates; absent for an exhaustive shard and any whole
+    /// run, so a whole run's records serve either strategy).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub guided: Option<super::strategy::Selection>,
 }
 
 /// Shard K of N (1 ≤ K ≤ N), written `K/N`.

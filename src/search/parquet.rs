@@ -387,6 +387,13 @@ const TAIL: &[Column] = &[
         "starting points run",
     ),
     col(
+        "warm_start",
+        &["warm_start"],
+        Bool,
+        "",
+        "the optimum came from a warm start at the parent's optimum (guided search)",
+    ),
+    col(
         "evaluations",
         &["evaluations"],
         Int,

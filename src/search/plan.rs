@@ -34,6 +34,9 @@ pub struct PlannedGraph {
     pub level: usize,
     /// Constraints ψ the rules added (Eq. 31–35): the size of its optimization problem.
     pub constraints: usize,
+    /// The graph it was made from by one rule application, when that graph is
+    /// meaningful too (its index here): the guided search's warm starts come from it.
+    pub parent: Option<usize>,
 }
 
 /// One compiled model's share of the search: a graph, a gripping candidate, all 2^N mode
@@ -110,7 +113,15 @@ impl Plan {
         let mut graphs = Vec::new();
         let mut tree = Vec::new();
         let mut tree_full = false;
+        // Generation index → index among the meaningful graphs (u32::MAX: not meaningful).
+        let mut meaningful_index: Vec<u32> = Vec::new();
         let streamed = Enumeration::stream_with(task, n_max, Filters::all(), rules, |g| {
+            debug_assert_eq!(meaningful_index.len(), g.index, "generation order");
+            meaningful_index.push(if g.status == Status::Meaningful {
+                graphs.len() as u32
+            } else {
+                u32::MAX
+            });
             if !tree_full {
                 if tree.len() == TREE_NODES_MAX {
                     tree_full = true;
@@ -137,6 +148,11 @@ impl Plan {
                     n: g.graph.internal_count(),
                     level: g.level,
                     constraints: g.graph.constraints().len(),
+                    parent: g
+                        .parent
+                        .map(|p| meaningful_index[p])
+                        .filter(|&p| p != u32::MAX)
+                        .map(|p| p as usize),
                 });
             }
         });

@@ -70,6 +70,10 @@ pub struct AlternativeRecord {
     pub variables: BTreeMap<String, f64>,
     /// Starting points run.
     pub starts_run: usize,
+    /// The optimum came from a warm start (a guided search's start from the parent's
+    /// optimum, tried after the quasi-random starts failed).
+    #[serde(default)]
+    pub warm_start: bool,
     /// Model evaluations spent.
     pub evaluations: usize,
     /// Milliseconds optimizing (CPU time of the worker thread).
@@ -352,6 +356,8 @@ pub struct Tally {
     pub short_of_margins: usize,
     /// The records from cyclic graphs (r2′); `graphs` is left 0.
     pub cyclic: CyclicCounts,
+    /// Per number of internal vertices N (index N − 1): records and feasible designs.
+    pub by_vertices: Vec<(u64, u64)>,
 }
 
 impl Tally {
@@ -379,6 +385,13 @@ impl Tally {
             self.near_rigid_limit += usize::from(rob.is_some_and(|x| x.rigid_margin.value < 1e-3));
         }
         self.cyclic.add(r);
+        if let Some(i) = r.internal_vertices.checked_sub(1) {
+            if self.by_vertices.len() <= i {
+                self.by_vertices.resize(i + 1, (0, 0));
+            }
+            self.by_vertices[i].0 += 1;
+            self.by_vertices[i].1 += u64::from(r.feasible_design());
+        }
         while self.levels.len() < r.level {
             self.levels.push(LevelCounts {
                 level: self.levels.len() + 1,
@@ -454,6 +467,9 @@ pub struct Summary {
     /// With r2′ enabled: what came from cyclic graphs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cyclic: Option<CyclicCounts>,
+    /// How much of the design space the run covered, per number of internal vertices.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coverage: Option<super::strategy::Coverage>,
 }
 
 /// The share of a search that comes from cyclic graphs (r2′).
@@ -540,6 +556,9 @@ impl Summary {
             self.alternatives,
             th(0)
         );
+        if let Some(c) = self.coverage.as_ref().filter(|c| c.alternatives < c.total) {
+            s += &format!("  ({})\n", c.text());
+        }
         s += &format!(
             "  meet the target                     {:>6}{}\n",
             self.meets_target,

@@ -469,10 +469,12 @@ fn report_input(
             task: task.name.clone(),
             counts,
             timings,
-            notes: vec![format!(
+            notes: std::iter::once(format!(
                 "Times: compile, optimize and check add up every worker's time (CPU seconds); the export (design files and this page) follows the search and is in summary.json. {} of the alternatives were taken over from an earlier run (--resume).",
                 s.settings["resumed"]
-            )],
+            ))
+            .chain(s.coverage.as_ref().map(|c| format!("Coverage: the {}.", c.text())))
+            .collect(),
         },
         task: task_rows,
         tree,

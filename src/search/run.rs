@@ -3,6 +3,7 @@
 //! summary, designs, report; a shard instead reports its share in `shard.json`.
 
 use super::finish::finish;
+use super::guide;
 use super::open::{open_output, settings};
 use super::options::{
     SHARD_REPORT, SHARD_TASK, SearchError, SearchOptions, ShardReport, Share, check_search,
@@ -13,6 +14,7 @@ use super::progress::Progress;
 use super::readback::tally_records;
 use super::record::{Summary, Timings};
 use super::schedule::evaluate_units;
+use super::strategy::Strategy;
 use crate::task::Task;
 use std::time::Instant;
 
@@ -30,8 +32,11 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
         plan.graphs.len()
     ));
     let (out, resume) = open_output(&settings(task, n_max, opts, None), opts)?;
-    let all: Vec<usize> = (0..plan.units.len()).collect();
-    let ev = evaluate_units(task, &plan, &all, &out, resume, opts, &progress)?;
+    let units = match opts.strategy {
+        Strategy::Exhaustive => (0..plan.units.len()).collect(),
+        Strategy::Guided => guide::select(&plan, opts.budget.alternatives),
+    };
+    let ev = evaluate_units(task, &plan, &units, &out, resume, opts, &progress)?;
     finish(task, &plan, &out, opts, &ev, start, &progress)
 }
 

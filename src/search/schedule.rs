@@ -4,11 +4,14 @@
 //! `OUT/alternatives.jsonl` as it finishes, the model dropped after its last alternative.
 
 use super::evaluate::{Prepared, evaluate, prepare};
+use super::guide;
 use super::options::{Evaluation, FailedModel, SearchError, SearchOptions};
 use super::output::{self, OutputDir, RECORDS, ResumeReport};
 use super::plan::{Done, Plan};
 use super::progress::Progress;
 use super::record::AlternativeRecord;
+use super::strategy::Strategy;
+use super::warm::Optima;
 use crate::cpu_time::Stopwatch;
 use crate::grammar::CreaseGraph;
 use crate::model::compiled::CompiledModel;
@@ -20,6 +23,7 @@ use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::Write;
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Evaluate every alternative of `units` not yet in `OUT/alternatives.jsonl` (with
 /// `resume`, the records of an earlier run of the same settings are kept), streaming
@@ -37,7 +41,18 @@ pub fn evaluate_units(
     opts: &SearchOptions,
     progress: &Progress,
 ) -> Result<Evaluation, SearchError> {
-    let (records_file, report, done) = keep_records(plan, units, out, resume)?;
+    // A guided run keeps any record of the plan: an earlier run of a larger budget, or an
+    // exhaustive one, holds records outside this budget's models that are still its own.
+    let all: Vec<usize>;
+    let kept_units = if opts.strategy == Strategy::Guided {
+        all = (0..plan.units.len()).collect();
+        &all
+    } else {
+        units
+    };
+    let optima = (opts.strategy == Strategy::Guided && opts.warm_starts).then(Optima::default);
+    let (records_file, report, done, kept_cpu_s) =
+        keep_records(plan, kept_units, out, resume, optima.as_ref())?;
     // The units with work left; their modes are listed when a worker takes them up.
     let done = &done;
     let undone = move |u: usize| {
@@ -60,12 +75,11 @@ pub fn evaluate_units(
         compile_s: Mutex::new(0.0f64),
         failed: Mutex::new(Vec::new()),
         robust_spec: (!opts.post_check_only).then(|| RobustSpec::from_task(task, opts.sweep)),
+        optima,
     };
-    progress.phase(
-        "compile + optimize + check",
-        "alternatives",
-        Some(remaining as u64),
-    );
+    // A CPU budget ends the run before its list: no total to show, or an ETA in days.
+    let total = opts.budget.cpu_s.is_none().then_some(remaining as u64);
+    progress.phase("compile + optimize + check", "alternatives", total);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.jobs)
         .build()
@@ -73,12 +87,27 @@ pub fn evaluate_units(
             task: task.name.clone(),
             message: e.to_string(),
         })?;
-    pool.install(|| {
-        todo.par_iter().for_each(|&u| {
-            let modes: Vec<u32> = undone(u).collect();
-            work.unit(u, &modes);
-        });
-    });
+    match opts.strategy {
+        Strategy::Exhaustive => pool.install(|| {
+            todo.par_iter().for_each(|&u| {
+                let modes: Vec<u32> = undone(u).collect();
+                work.unit(u, &modes);
+            });
+        }),
+        Strategy::Guided => {
+            let spent = Spent::new(opts.budget.cpu_s, kept_cpu_s);
+            let mut todo = todo.clone();
+            todo.sort_by_key(|&u| guide::rank(plan, u));
+            // One score at a time: a parent's optimum is on record before its r1
+            // children (one score lower) start, on any number of workers.
+            for tier in todo.chunk_by(|&a, &b| unit_score(plan, a) == unit_score(plan, b)) {
+                in_order(&pool, tier, &spent, progress, |u| {
+                    let modes: Vec<u32> = undone(u).collect();
+                    work.unit(u, &modes);
+                });
+            }
+        }
+    }
     progress.finish_phase();
     if progress.cancelled() {
         return Err(SearchError::Interrupted {
@@ -114,7 +143,9 @@ fn keep_records(
     units: &[usize],
     out: &OutputDir,
     resume: bool,
-) -> Result<(File, Option<ResumeReport>, Done), SearchError> {
+    optima: Option<&Optima>,
+) -> Result<(File, Option<ResumeReport>, Done, f64), SearchError> {
+    let mut kept_ms = 0.0;
     let mut mine = vec![false; plan.units.len()];
     for &u in units {
         mine[u] = true;
@@ -131,6 +162,10 @@ fn keep_records(
                 )
             })?;
         if done.insert(place.index) {
+            kept_ms += r.optimize_ms + r.check_ms;
+            if let Some(o) = optima {
+                o.keep(plan, place.unit, place.index, r);
+            }
             Ok(())
         } else {
             Err(format!(
@@ -142,7 +177,55 @@ fn keep_records(
     if let Some(report) = &report {
         eprintln!("{}", report.text(&out.path(RECORDS)));
     }
-    Ok((records_file, report, done))
+    Ok((records_file, report, done, kept_ms / 1e3))
+}
+
+/// The CPU budget of a guided search: seconds this process has spent since the
+/// evaluation began, plus those of the records a resumed run keeps.
+struct Spent {
+    budget_s: Option<f64>,
+    start_s: f64,
+    kept_s: f64,
+}
+
+impl Spent {
+    fn new(budget_s: Option<f64>, kept_s: f64) -> Spent {
+        Spent {
+            budget_s,
+            start_s: crate::cpu_time::process_seconds(),
+            kept_s,
+        }
+    }
+    /// Whether the budget is spent (never without one).
+    fn exhausted(&self) -> bool {
+        self.budget_s
+            .is_some_and(|b| crate::cpu_time::process_seconds() - self.start_s + self.kept_s >= b)
+    }
+}
+
+/// Run `each` on `units` in their order on `pool`: each worker takes the next unit not
+/// yet taken (a parallel iterator would split the list and start its second half at
+/// once), until the units or the CPU budget run out.
+fn in_order(
+    pool: &rayon::ThreadPool,
+    units: &[usize],
+    spent: &Spent,
+    progress: &Progress,
+    each: impl Fn(usize) + Sync,
+) {
+    let next = AtomicUsize::new(0);
+    pool.scope(|s| {
+        for _ in 0..pool.current_num_threads() {
+            s.spawn(|_| {
+                while let Some(&u) = units.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    if spent.exhausted() || progress.cancelled() {
+                        break;
+                    }
+                    each(u);
+                }
+            });
+        }
+    });
 }
 
 /// What the workers share: the search, the records file, and what they report.
@@ -160,6 +243,8 @@ struct Work<'a> {
     failed: Mutex<Vec<FailedModel>>,
     /// The robustness block every model gets (absent with `--post-check-only`).
     robust_spec: Option<RobustSpec>,
+    /// The optima warm starts come from (a guided search with warm starts).
+    optima: Option<Optima>,
 }
 
 impl Work<'_> {
@@ -223,8 +308,18 @@ impl Work<'_> {
                 return;
             }
             let alt = self.plan.alternative(u, m);
-            match evaluate(self.task, prepared, &alt, graph, self.opts, &shared) {
-                Ok(rec) => self.write(&rec),
+            let warm = self
+                .optima
+                .as_ref()
+                .map_or_else(Vec::new, |o| o.starts(self.plan, u, m, &prepared.model));
+            match evaluate(self.task, prepared, &alt, graph, self.opts, &shared, warm) {
+                Ok(rec) => {
+                    self.write(&rec);
+                    if let Some(o) = &self.optima {
+                        let index = self.plan.units[u].first + u64::from(m);
+                        o.keep(self.plan, u, index, &rec);
+                    }
+                }
                 Err(error) => self.block_failed(u, error),
             }
             self.progress.inc(1);
@@ -295,4 +390,9 @@ fn alternative_seed(seed: u64, key: &str) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
+}
+
+/// The guided score of unit `u`'s graph.
+fn unit_score(plan: &Plan, u: usize) -> i64 {
+    guide::score(&plan.graphs[plan.units[u].graph])
 }

@@ -44,6 +44,7 @@ pub fn summary(dir: &Path) -> Value {
 }
 
 /// Every file under `dir/designs`, path relative to `dir` → bytes.
+#[allow(dead_code)] // the guided search's tests compare records and summaries only
 pub fn design_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut out = BTreeMap::new();
     let mut stack = vec![dir.join("designs")];
