@@ -201,6 +201,24 @@ impl Cluster {
     }
 
     /// `scontrol show job ID` as key=value pairs, one map per job (array tasks).
+    /// Wait for job `id` (a merge job: it runs only after every shard succeeded); its
+    /// final state and reason.
+    fn wait(&self, id: &str) -> String {
+        let t0 = Instant::now();
+        loop {
+            let job = self.jobs(id).pop().unwrap_or_default();
+            let state = job.get("JobState").cloned().unwrap_or_default();
+            let reason = job.get("Reason").cloned().unwrap_or_default();
+            if DONE.contains(&state.as_str()) || reason == "DependencyNeverSatisfied" {
+                return format!("{state} ({reason})");
+            }
+            if t0.elapsed() > Duration::from_secs(1800) {
+                return format!("still {state} ({reason}) after 30 min");
+            }
+            std::thread::sleep(Duration::from_secs(1));
+        }
+    }
+
     fn jobs(&self, id: &str) -> Vec<BTreeMap<String, String>> {
         let o = self
             .cmd("scontrol")
@@ -316,20 +334,7 @@ fn four_slurm_shards_merged_equal_the_single_machine_run() {
         "{script}"
     );
 
-    // Wait for the merge job; it runs only after every shard succeeded.
-    let t0 = Instant::now();
-    let merge_state = loop {
-        let job = cluster.jobs(&merge).pop().unwrap_or_default();
-        let state = job.get("JobState").cloned().unwrap_or_default();
-        let reason = job.get("Reason").cloned().unwrap_or_default();
-        if DONE.contains(&state.as_str()) || reason == "DependencyNeverSatisfied" {
-            break format!("{state} ({reason})");
-        }
-        if t0.elapsed() > Duration::from_secs(1800) {
-            break format!("still {state} ({reason}) after 30 min");
-        }
-        std::thread::sleep(Duration::from_secs(1));
-    };
+    let merge_state = cluster.wait(&merge);
     let shard_states: Vec<String> = cluster
         .jobs(&array)
         .iter()
@@ -388,4 +393,69 @@ fn four_slurm_shards_merged_equal_the_single_machine_run() {
         .collect();
     assert_eq!(per_shard.iter().sum::<usize>(), 1194, "{per_shard:?}");
     assert!(per_shard.iter().all(|&n| n > 0), "{per_shard:?}");
+}
+
+#[test]
+fn a_guided_search_in_slurm_shards_is_the_single_machine_guided_run() {
+    let Some(cluster) = cluster_or_skip() else {
+        return;
+    };
+    let work = cluster.dir.path().join("guided");
+    let settings = ["--n-max", "3", "--starts", "4", "--seed", "2"];
+    let guided = ["--strategy", "guided", "--budget-alternatives", "300"];
+    let o = cluster
+        .cmd(env!("CARGO_BIN_EXE_foldsynth"))
+        .args(["slurm", GRIPPER, "--shards", "3", "--cpus-per-task", "1"])
+        .args(settings)
+        .args(guided)
+        .args(["--no-export", "--submit", "--out"])
+        .arg(&work)
+        .output()
+        .unwrap();
+    let said = stdout(&o);
+    assert!(
+        o.status.success(),
+        "{said}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let script = std::fs::read_to_string(work.join("shards.sbatch")).unwrap();
+    assert!(
+        script.contains("--strategy guided --budget-alternatives 300"),
+        "{script}"
+    );
+    let merge = said
+        .split_whitespace()
+        .skip_while(|w| *w != "merge")
+        .nth(2)
+        .expect("the merge job's id printed")
+        .to_string();
+    let state = cluster.wait(&merge);
+    assert!(
+        state.starts_with("COMPLETED"),
+        "merge job {merge}: {state}\n{}",
+        cluster.logs()
+    );
+    // Shards start from no parent's optimum: the single run without warm starts.
+    let single = cluster.dir.path().join("single-guided");
+    let o = Command::new(env!("CARGO_BIN_EXE_foldsynth"))
+        .args([
+            "synthesize",
+            GRIPPER,
+            "--jobs",
+            "2",
+            "--no-export",
+            "--no-warm-starts",
+        ])
+        .args(settings)
+        .args(guided)
+        .arg("--out")
+        .arg(&single)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let merged = work.join("result");
+    let whole = records(&single);
+    assert!(whole.len() >= 300 && whole.len() < 1194, "{}", whole.len());
+    assert_eq!(records(&merged), whole, "merged records differ");
+    assert_eq!(summary(&merged), summary(&single));
 }

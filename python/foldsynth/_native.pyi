@@ -152,6 +152,10 @@ def synthesize(
     shard: Optional[str] = None,
     rules: str = "r1,r2",
     post_check_only: bool = False,
+    strategy: str = "exhaustive",
+    budget_alternatives: Optional[int] = None,
+    budget_cpu: Optional[float] = None,
+    warm_starts: bool = True,
     callback: Optional[Callable[[str, str, int, Optional[int], bool], Any]] = None,
 ) -> Dict[str, Any]:
     """The search (native half of ``foldsynth.synthesize``): ``callback(phase, unit,

@@ -118,6 +118,10 @@ def synthesize(
     shard: Optional[str] = None,
     rules: str = "r1,r2",
     post_check_only: bool = False,
+    strategy: str = "exhaustive",
+    budget_alternatives: Optional[int] = None,
+    budget_cpu: Optional[float] = None,
+    warm_starts: bool = True,
     progress: Union[bool, Callable[[ProgressEvent], Any]] = True,
 ) -> "Run":
     """Run the whole method on ``task`` (a ``Task`` or a task file) into the directory
@@ -136,7 +140,9 @@ def synthesize(
     design being a row of its table, or ``"all"``),
     ``shard`` (``--shard``: ``"K/N"`` runs only shard K of N into ``out``, records only;
     ``foldsynth merge`` joins the shards, ``Run.open`` reads each), ``rules`` (``"r1,r2"``
-    or ``"r1,r2,r2p"``), ``post_check_only``.
+    or ``"r1,r2,r2p"``), ``post_check_only``, ``strategy`` (``--strategy``: ``"exhaustive"``
+    or ``"guided"``), ``budget_alternatives`` and ``budget_cpu`` (a guided search's budget
+    in alternatives or CPU seconds), ``warm_starts`` (``False`` = ``--no-warm-starts``).
 
     The search runs natively with the GIL released. ``progress``: ``True`` shows a tqdm bar
     per phase where tqdm is installed (nothing otherwise), ``False`` nothing, a callable is
@@ -171,6 +177,10 @@ def synthesize(
             shard=shard,
             rules=rules,
             post_check_only=post_check_only,
+            strategy=strategy,
+            budget_alternatives=budget_alternatives,
+            budget_cpu=budget_cpu,
+            warm_starts=warm_starts,
             callback=callback,
         )
     finally:

@@ -216,6 +216,10 @@ impl Task {
             None,
             rules,
             post_check_only,
+            "exhaustive",
+            None,
+            None,
+            true,
             None,
         )
     }

@@ -159,7 +159,7 @@ pub fn search<'py>(
 /// `callback(phase, unit, done, total, finished)` with its progress; returns the summary.
 /// `foldsynth.synthesize` wraps it and returns a `Run`.
 #[pyfunction]
-#[pyo3(signature = (task, out, *, jobs = 0, starts = 16, seed = 0, resume = false, force = false, n_max = None, sweep = 181, export = true, export_top = None, export_all = false, report_motions = None, report_motions_all = false, report_designs = None, report_designs_all = false, shard = None, rules = "r1,r2", post_check_only = false, callback = None))]
+#[pyo3(signature = (task, out, *, jobs = 0, starts = 16, seed = 0, resume = false, force = false, n_max = None, sweep = 181, export = true, export_top = None, export_all = false, report_motions = None, report_motions_all = false, report_designs = None, report_designs_all = false, shard = None, rules = "r1,r2", post_check_only = false, strategy = "exhaustive", budget_alternatives = None, budget_cpu = None, warm_starts = true, callback = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn synthesize<'py>(
     py: Python<'py>,
@@ -182,10 +182,17 @@ pub fn synthesize<'py>(
     shard: Option<&str>,
     rules: &str,
     post_check_only: bool,
+    strategy: &str,
+    budget_alternatives: Option<u64>,
+    budget_cpu: Option<f64>,
+    warm_starts: bool,
     callback: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let rules =
         Rules::parse(rules).map_err(|e| PyValueError::new_err(format!("rules {rules:?}: {e}")))?;
+    let strategy: search::Strategy = strategy
+        .parse()
+        .map_err(|e| PyValueError::new_err(format!("strategy: {e}")))?;
     let shard = match shard {
         None => None,
         Some(text) => {
@@ -233,6 +240,12 @@ pub fn synthesize<'py>(
         } else {
             Some(report_designs.unwrap_or(search::REPORT_DESIGNS))
         },
+        strategy,
+        budget: search::Budget {
+            alternatives: budget_alternatives,
+            cpu_s: budget_cpu,
+        },
+        warm_starts,
         ..SearchOptions::default()
     };
     search(py, &task.task, opts, shard, callback)

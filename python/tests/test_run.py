@@ -323,3 +323,28 @@ def test_the_example_runs(tmp_path):
     except ImportError:
         return
     assert (out / "tip_path.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_guided_search_spends_its_budget(task, tmp_path):
+    # A budget of 50 alternatives: whole models in the guided order, at least 50 and less
+    # than 50 plus one model's 2^N; the summary says how much of the space it covered.
+    run = foldsynth.synthesize(
+        task,
+        out=tmp_path / "guided",
+        n_max=3,
+        starts=4,
+        export=False,
+        strategy="guided",
+        budget_alternatives=50,
+        progress=False,
+    )
+    coverage = run.summary["coverage"]
+    assert coverage["strategy"] == "guided"
+    assert coverage["budget"] == {"alternatives": 50}
+    assert 50 <= coverage["alternatives"] < 50 + 3 * 2**3
+    assert coverage["total"] == 1194
+    assert len(run.alternatives(as_="records")) == coverage["alternatives"]
+    with pytest.raises(foldsynth.FoldsynthError, match="--strategy guided"):
+        foldsynth.synthesize(task, out=tmp_path / "b", budget_alternatives=5, progress=False)
+    with pytest.raises(ValueError, match="strategy"):
+        foldsynth.synthesize(task, out=tmp_path / "c", strategy="random", progress=False)

@@ -360,6 +360,14 @@ pub fn status_line(
     elapsed: Duration,
 ) -> String {
     let Some(total) = total else {
+        if done > 0 {
+            // An open-ended count (a guided search's CPU budget): what is done, and how fast.
+            return format!(
+                "{name}: {done} {unit}, {:.1}/s, elapsed {}",
+                rate(done, elapsed).unwrap_or(0.0),
+                human_duration(elapsed)
+            );
+        }
         return format!("{name}: running for {}", human_duration(elapsed));
     };
     let pct = if total == 0 {
@@ -418,6 +426,14 @@ mod tests {
         assert!(l.contains("0/7 items (0%), –/s, ETA unknown"), "{l}");
         let l = status_line("enumerate", "graphs", 0, None, Duration::from_secs(75));
         assert_eq!(l, "enumerate: running for 1 min 15 s");
+        let l = status_line(
+            "optimize",
+            "alternatives",
+            50,
+            None,
+            Duration::from_secs(20),
+        );
+        assert_eq!(l, "optimize: 50 alternatives, 2.5/s, elapsed 20 s");
     }
 
     #[test]

@@ -50,7 +50,7 @@ pub fn evaluate_units(
     } else {
         units
     };
-    let optima = (opts.strategy == Strategy::Guided && opts.warm_starts).then(Optima::default);
+    let optima = (opts.strategy == Strategy::Guided && opts.warm_starts).then(|| Optima::new(plan));
     let (records_file, report, done, kept_cpu_s) =
         keep_records(plan, kept_units, out, resume, optima.as_ref())?;
     // The units with work left; their modes are listed when a worker takes them up.
