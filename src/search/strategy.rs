@@ -11,7 +11,7 @@ pub enum Strategy {
     /// Every alternative, in enumeration order (the thesis's method and the reference).
     #[default]
     Exhaustive,
-    /// The models in the order of [`score`], up to a [`Budget`].
+    /// The models in the order of [`score`](super::guide::score), up to a [`Budget`].
     Guided,
 }
 
