@@ -36,6 +36,11 @@ fn ok(o: Output) -> Output {
 
 /// `synthesize GRIPPER` with small settings and `extra`, into `out`.
 fn synthesize(out: &Path, n_max: &str, extra: &[&str]) -> Output {
+    foldsynth(&synthesize_args(out, n_max, extra))
+}
+
+/// The arguments of [`synthesize`].
+fn synthesize_args<'a>(out: &'a Path, n_max: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "synthesize",
         GRIPPER,
@@ -50,7 +55,7 @@ fn synthesize(out: &Path, n_max: &str, extra: &[&str]) -> Output {
         out.to_str().unwrap(),
     ];
     args.extend(extra);
-    foldsynth(&args)
+    args
 }
 
 fn plan(n_max: usize) -> Plan {
@@ -376,20 +381,7 @@ fn a_killed_guided_run_resumes_to_the_uninterrupted_records() {
     ];
     ok(synthesize(&whole, "3", &budget));
     let killed = root.path().join("killed");
-    let mut args = vec![
-        "synthesize",
-        GRIPPER,
-        "--n-max",
-        "3",
-        "--starts",
-        "4",
-        "--seed",
-        "5",
-        "--no-export",
-        "--out",
-        killed.to_str().unwrap(),
-    ];
-    args.extend(budget);
+    let mut args = synthesize_args(&killed, "3", &budget);
     let mut child = Command::new(env!("CARGO_BIN_EXE_foldsynth"))
         .args(&args)
         .stdout(std::process::Stdio::null())
