@@ -24,7 +24,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::copies::{CopiedPattern, copy_crossings, with_copies};
-use super::distance::{Aabb, closest_on_triangle, farther_than, triangle_distance};
+use super::distance::{apart_beyond, bounding_sphere, closest_on_triangle, triangle_distance};
 use super::rotated_copy::RotatedCopyError;
 use super::self_intersection::{CheckError, Checker};
 use super::shapes::facet_clearance;
@@ -456,16 +456,16 @@ pub fn judge_copies(copied: &CopiedPattern, n: usize) -> Result<CopiesReport, Ch
     let mut least: Option<f64> = None;
     for fr in &pat.frames {
         let tris = facet_triangles(&checker, &fr.coords);
-        // Boxes rule out the pairs that cannot beat the least so far (most of them once
+        // Spheres rule out the pairs that cannot beat the least so far (most of them once
         // the first frame has set it); the answer is the same as testing every pair.
-        let boxes: Vec<Vec<Aabb>> = tris
+        let spheres: Vec<Vec<(V, f64)>> = tris
             .iter()
-            .map(|ts| ts.iter().map(|t| Aabb::around(t)).collect())
+            .map(|ts| ts.iter().map(bounding_sphere).collect())
             .collect();
         for &(a, b) in &apart {
-            for (ta, ba) in tris[a].iter().zip(&boxes[a]) {
-                for (tb, bb) in tris[b].iter().zip(&boxes[b]) {
-                    if least.is_some_and(|l| farther_than(ba, bb, l)) {
+            for (ta, &sa) in tris[a].iter().zip(&spheres[a]) {
+                for (tb, &sb) in tris[b].iter().zip(&spheres[b]) {
+                    if least.is_some_and(|l| apart_beyond(sa, sb, l)) {
                         continue;
                     }
                     let d = triangle_distance(ta, tb);

@@ -29,7 +29,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::cylinder::Cylinder;
-use super::distance::point_segment_distance;
+use super::distance::{SLACK, apart_beyond, bounding_sphere, point_segment_distance};
 pub use super::distance::{segment_triangle_distance, triangle_distance};
 use super::features::{self, FeatureKind};
 use super::self_intersection::{CheckError, Checker};
@@ -591,20 +591,6 @@ pub fn score(r: &RobustnessReport) -> f64 {
 }
 
 /// Rounding allowance of the pruning bounds (paper units or radians).
-const SLACK: f64 = 1e-12;
-
-/// A sphere around a triangle: its centroid and the farthest corner's distance.
-fn bounding_sphere(t: &Tri) -> (V, f64) {
-    let c = (t[0] + t[1] + t[2]) / 3.0;
-    let r = t.iter().map(|p| (p - c).norm()).fold(0.0, f64::max);
-    (c, r)
-}
-
-/// Whether everything in two bounding spheres is farther apart than `limit`.
-fn apart_beyond((ca, ra): (V, f64), (cb, rb): (V, f64), limit: f64) -> bool {
-    (ca - cb).norm() - ra - rb - SLACK > limit
-}
-
 /// The cone angle whose chord `2 sin(θ/2)` is `chord` (π for chords of 2 or more).
 fn chord_angle(chord: f64) -> f64 {
     if chord >= 2.0 {
