@@ -563,33 +563,40 @@ fn drive(pages: &[&Path], broken: &Path) -> Value {
 /// Designs of the large page (issue 34: a run of 100,000 designs).
 const LARGE: usize = 100_000;
 
-/// The large page of [`report_works_in_headless_chromium_moved_alone`]: a page of 100 rows
-/// at a time, the next page the next 100 of the same order, and a design carried as a row
-/// only selected by its row: its values, and the command that draws it, no 3D view.
-fn assert_large_page_works(r: &Value, data: &Value) {
+/// A page that carries some designs as table rows only (the large page of
+/// [`report_works_in_headless_chromium_moved_alone`], or a real run's): 100 rows at a time,
+/// the next page the next 100 of the same order, and a design carried as a row only
+/// selected by its row: its values, and the command that draws it, no 3D view.
+fn assert_paged_table_works(r: &Value, data: &Value) {
+    let file = &r["file"];
     assert!(
         r["errors"].as_array().unwrap().is_empty(),
-        "{}",
+        "{file}: {}",
         r["errors"]
     );
-    assert_eq!(data["designs"].as_array().unwrap().len(), 3);
-    assert_eq!(data["rows"].as_array().unwrap().len(), LARGE);
+    let rows = data["rows"].as_array().unwrap().len();
+    let full = data["designs"].as_array().unwrap().len();
+    assert!(
+        rows > 100 && full < rows,
+        "{file}: {rows} rows, {full} in full"
+    );
+    let pages = rows.div_ceil(100);
     let first = &r["pager"]["first"];
-    assert_eq!(first["pages"], LARGE / 100);
+    assert_eq!(first["pages"], pages);
     assert_eq!(first["page"], 0);
     assert_eq!(ids(&first["rows"]).len(), 100);
     assert_eq!(
         first["info"],
-        format!("rows 1–100 of {LARGE} (page 1 of {})", LARGE / 100)
+        format!("rows 1–100 of {rows} (page 1 of {pages})")
     );
     let next = &r["pager"]["next"];
     assert_eq!(next["page"], 1);
     let (a, b) = (ids(&first["rows"]), ids(&next["rows"]));
-    assert_eq!(b.len(), 100);
-    assert!(a.iter().all(|id| !b.contains(id)), "pages overlap");
+    assert_eq!(b.len(), 100.min(rows - 100));
+    assert!(a.iter().all(|id| !b.contains(id)), "{file}: pages overlap");
     assert_eq!(
         next["info"],
-        format!("rows 101–200 of {LARGE} (page 2 of {})", LARGE / 100)
+        format!("rows 101–{} of {rows} (page 2 of {pages})", 200.min(rows))
     );
     // On opening, the page shows the first 100 of the most robust first order.
     assert_eq!(ids(&r["initial"]["table"]["order"]).len(), 100);
@@ -659,68 +666,13 @@ fn column(data: &Value, key: &str) -> Vec<(String, Option<f64>)> {
         .collect()
 }
 
-/// What every report must show in the browser, whatever its designs.
+/// What every report must show in the browser, whatever its designs: the view
+/// ([`assert_view_works`]), and a table whose sorts and filters keep exactly the right rows
+/// (a page that carries every design in full).
 fn assert_page_works(r: &Value, data: &Value) {
+    assert_view_works(r, data);
     let file = &r["file"];
-    assert_eq!(r["errors"], json!([]), "{file}: console errors");
-    assert_eq!(
-        r["requests"],
-        json!([]),
-        "{file}: the page loaded something"
-    );
     let designs = data["designs"].as_array().unwrap();
-    let init = &r["initial"];
-    assert_eq!(init["detail"]["webgl"], true, "{file}");
-    // The 3D view is drawn: a good share of the canvas is not background.
-    let px = &r["pixels_initial"];
-    assert!(
-        f(&px["ink"]) > 0.01 * f(&px["total"]),
-        "{file}: 3D canvas nearly empty: {px}"
-    );
-    // The slider: Home is the flat state (t = 0), End the last frame (t = t_max); the
-    // picture changes between them.
-    let sel = init["detail"]["selected"].as_str().unwrap();
-    let d = designs.iter().find(|d| d["id"] == sel).unwrap();
-    let ts = d["geometry"]["t"].as_array().unwrap();
-    let home = &r["slider_home"]["detail"];
-    assert_eq!(home["frame"], 0, "{file}");
-    assert!(home["t"].as_str().unwrap().starts_with("t = 0.0000 "));
-    let end = &r["slider_end"]["detail"];
-    assert_eq!(f(&end["frame"]) as usize, ts.len() - 1, "{file}");
-    assert!(
-        end["t"]
-            .as_str()
-            .unwrap()
-            .starts_with(&format!("t = {:.4} ", f(ts.last().unwrap()))),
-        "{}",
-        end["t"]
-    );
-    assert!(
-        f(&r["slider_end"]["changed_vs_home"]) >= 10.0,
-        "{file}: moving the slider did not change the picture"
-    );
-    assert!(f(&r["drag"]["changed_vs_end"]) >= 10.0, "{file}: drag");
-    assert_ne!(
-        r["play"]["frame_before"], r["play"]["frame_after"],
-        "{file}"
-    );
-    assert_eq!(r["play"]["button"], "play");
-    // The crease pattern of the selected design: one line per edge, its assignment, the
-    // vertices named v1 … vn, the gripping vertex circled.
-    let cp = &init["detail"]["cp"];
-    let assign: Vec<String> = d["geometry"]["assign"]
-        .as_str()
-        .unwrap()
-        .chars()
-        .map(String::from)
-        .collect();
-    assert_eq!(ids(&cp["lines"]), assign);
-    let n = d["geometry"]["flat"].as_array().unwrap().len();
-    assert_eq!(
-        ids(&cp["labels"]),
-        (1..=n).map(|k| format!("v{k}")).collect::<Vec<_>>()
-    );
-    assert_eq!(cp["circles"], 1);
     // Sorting by a numeric column orders the rows by it (stable), both ways.
     for key in [
         "objective",
@@ -793,6 +745,71 @@ fn assert_page_works(r: &Value, data: &Value) {
     );
 }
 
+/// The page opens without an error or a request, and the selected design's 3D view, slider,
+/// drag, play button and crease pattern work.
+fn assert_view_works(r: &Value, data: &Value) {
+    let file = &r["file"];
+    assert_eq!(r["errors"], json!([]), "{file}: console errors");
+    assert_eq!(
+        r["requests"],
+        json!([]),
+        "{file}: the page loaded something"
+    );
+    let designs = data["designs"].as_array().unwrap();
+    let init = &r["initial"];
+    assert_eq!(init["detail"]["webgl"], true, "{file}");
+    // The 3D view is drawn: a good share of the canvas is not background.
+    let px = &r["pixels_initial"];
+    assert!(
+        f(&px["ink"]) > 0.01 * f(&px["total"]),
+        "{file}: 3D canvas nearly empty: {px}"
+    );
+    // The slider: Home is the flat state (t = 0), End the last frame (t = t_max); the
+    // picture changes between them.
+    let sel = init["detail"]["selected"].as_str().unwrap();
+    let d = designs.iter().find(|d| d["id"] == sel).unwrap();
+    let ts = d["geometry"]["t"].as_array().unwrap();
+    let home = &r["slider_home"]["detail"];
+    assert_eq!(home["frame"], 0, "{file}");
+    assert!(home["t"].as_str().unwrap().starts_with("t = 0.0000 "));
+    let end = &r["slider_end"]["detail"];
+    assert_eq!(f(&end["frame"]) as usize, ts.len() - 1, "{file}");
+    assert!(
+        end["t"]
+            .as_str()
+            .unwrap()
+            .starts_with(&format!("t = {:.4} ", f(ts.last().unwrap()))),
+        "{}",
+        end["t"]
+    );
+    assert!(
+        f(&r["slider_end"]["changed_vs_home"]) >= 10.0,
+        "{file}: moving the slider did not change the picture"
+    );
+    assert!(f(&r["drag"]["changed_vs_end"]) >= 10.0, "{file}: drag");
+    assert_ne!(
+        r["play"]["frame_before"], r["play"]["frame_after"],
+        "{file}"
+    );
+    assert_eq!(r["play"]["button"], "play");
+    // The crease pattern of the selected design: one line per edge, its assignment, the
+    // vertices named v1 … vn, the gripping vertex circled.
+    let cp = &init["detail"]["cp"];
+    let assign: Vec<String> = d["geometry"]["assign"]
+        .as_str()
+        .unwrap()
+        .chars()
+        .map(String::from)
+        .collect();
+    assert_eq!(ids(&cp["lines"]), assign);
+    let n = d["geometry"]["flat"].as_array().unwrap().len();
+    assert_eq!(
+        ids(&cp["labels"]),
+        (1..=n).map(|k| format!("v{k}")).collect::<Vec<_>>()
+    );
+    assert_eq!(cp["circles"], 1);
+}
+
 #[test]
 fn report_works_in_headless_chromium_moved_alone() {
     let dir = tempfile::tempdir().unwrap();
@@ -861,9 +878,13 @@ fn report_works_in_headless_chromium_moved_alone() {
     );
     let reports = v["reports"].as_array().unwrap();
     assert_eq!(reports.len(), 3);
-    assert_large_page_works(
-        &reports[2],
-        &embedded(&std::fs::read_to_string(&large).unwrap()),
+    let data = embedded(&std::fs::read_to_string(&large).unwrap());
+    assert_eq!(data["designs"].as_array().unwrap().len(), 3);
+    assert_eq!(data["rows"].as_array().unwrap().len(), LARGE);
+    assert_paged_table_works(&reports[2], &data);
+    println!(
+        "the page of {LARGE} designs opened in {} ms",
+        reports[2]["open_ms"]
     );
     for (r, page) in reports.iter().zip([&sample, &real]) {
         let data = embedded(&std::fs::read_to_string(page).unwrap());
@@ -919,6 +940,45 @@ fn report_works_in_headless_chromium_moved_alone() {
             .as_str()
             .unwrap()
             .starts_with("t = 1.5708 (90.0°)")
+    );
+}
+
+/// Issue 34's measurement on a real run: the page named by `FOLDSYNTH_REPORT` (a run of
+/// 100,000 designs takes hours of CPU, so CI cannot make one; docs/guided-search.md has the
+/// run and the command) is at most 50 MB and in Chromium works as every page does, with its
+/// table paged. Prints its size and the time it took to open.
+#[test]
+#[ignore = "needs FOLDSYNTH_REPORT=path/to/report.html of a large run (see docs/guided-search.md)"]
+fn a_large_run_report_works_in_headless_chromium() {
+    let page = PathBuf::from(
+        std::env::var_os("FOLDSYNTH_REPORT").expect("FOLDSYNTH_REPORT names the report.html"),
+    );
+    let bytes = std::fs::metadata(&page)
+        .unwrap_or_else(|e| panic!("{}: {e}", page.display()))
+        .len();
+    assert!(bytes <= 50_000_000, "{bytes} bytes");
+    let dir = tempfile::tempdir().unwrap();
+    let broken = dir.path().join("broken.html");
+    std::fs::write(
+        &broken,
+        "<!DOCTYPE html><title>b</title><script>console.error('boom')</script>",
+    )
+    .unwrap();
+    let v = drive(&[&page], &broken);
+    assert!(
+        !v.is_null(),
+        "this test was asked for: it needs the browser"
+    );
+    let r = &v["reports"][0];
+    let data = embedded(&std::fs::read_to_string(&page).unwrap());
+    assert_view_works(r, &data);
+    assert_paged_table_works(r, &data);
+    println!(
+        "{}: {bytes} bytes, {} designs ({} in full), opened in {} ms",
+        page.display(),
+        data["rows"].as_array().unwrap().len(),
+        data["designs"].as_array().unwrap().len(),
+        r["open_ms"]
     );
 }
 

@@ -432,16 +432,51 @@ fn a_cpu_budget_stops_the_guided_search_early() {
     let plan = plan(3);
     let order = guide::order(&plan);
     assert!(!got.is_empty() && (got.len() as u64) < plan.alternatives);
-    // One worker takes the models in order: what it evaluated is a prefix of the order.
-    let n_units = (1..=order.len())
-        .find(|&k| keys(&plan, &order[..k]).len() >= got.len())
+    // One worker takes the models in order: what it evaluated is every alternative of a
+    // prefix of the order and some of the next model's (the budget is checked before each
+    // alternative, so the last model may be left part done).
+    let got: std::collections::BTreeSet<String> = got.keys().cloned().collect();
+    let whole = (0..=order.len())
+        .take_while(|&k| keys(&plan, &order[..k]).is_subset(&got))
+        .last()
         .unwrap();
-    assert_eq!(
-        got.keys()
-            .cloned()
-            .collect::<std::collections::BTreeSet<_>>(),
-        keys(&plan, &order[..n_units])
+    let prefix = keys(&plan, &order[..whole]);
+    let rest: Vec<&String> = got.difference(&prefix).collect();
+    assert!(whole < order.len(), "every model evaluated");
+    let next = keys(&plan, &order[whole..whole + 1]);
+    assert!(
+        rest.iter().all(|k| next.contains(*k)),
+        "records outside the order's prefix and its next model: {rest:?}"
     );
+}
+
+#[test]
+fn a_cpu_budget_is_checked_before_each_alternative() {
+    // A budget spent before the first alternative (a microsecond: compiling the first
+    // model takes longer) leaves each worker at most the one alternative it had started.
+    // Before issue 34's fix the budget was checked per model, and the first model's 2^N
+    // alternatives were all evaluated.
+    let root = tempfile::tempdir().unwrap();
+    for jobs in ["1", "2"] {
+        let out = root.path().join(format!("cpu-{jobs}"));
+        ok(synthesize(
+            &out,
+            "3",
+            &[
+                "--strategy",
+                "guided",
+                "--budget-cpu",
+                "1e-6",
+                "--jobs",
+                jobs,
+            ],
+        ));
+        let got = records(&out).len();
+        assert!(
+            got <= jobs.parse().unwrap(),
+            "{jobs} workers: {got} records"
+        );
+    }
 }
 
 #[test]

@@ -129,7 +129,19 @@ fn assert_err(e: &TaskError, field: &str, words: &[&str]) {
 
 #[test]
 fn the_base_case_is_valid() {
-    Task::from_toml_str(BASE, "ok.toml").unwrap();
+    // Every error test below edits BASE: it must load, as the file it spells out.
+    let t = Task::from_toml_str(BASE, "ok.toml").unwrap();
+    assert_eq!(t.n_max, 3);
+    assert!(t.symmetry.mirror_xz);
+    let g0 = &t.initial;
+    assert_eq!(g0.vertices.len(), 2);
+    assert_eq!(
+        (g0.vertices[1].xy, g0.vertices[1].ty),
+        ([1.0, 0.0], VertexType::Extendable)
+    );
+    assert_eq!(g0.creases.len(), 1);
+    assert_eq!((g0.creases[0].tail, g0.creases[0].head), (0, 1));
+    assert_eq!(g0.creases[0].drive.as_ref().unwrap().as_str(), "t");
 }
 
 #[test]

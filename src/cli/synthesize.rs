@@ -75,7 +75,8 @@ pub struct SynthesizeArgs {
     /// models); the same seed and budget give the same records.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     pub budget_alternatives: Option<u64>,
-    /// With `--strategy guided`: start no model after this many CPU seconds (all threads).
+    /// With `--strategy guided`: start no alternative after this many CPU seconds (all threads;
+    /// the run ends at most one alternative per worker past it)
     #[arg(long, value_name = "SECONDS")]
     pub budget_cpu: Option<f64>,
     /// With `--strategy guided`: no warm starts from the parents' optima (then an

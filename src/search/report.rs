@@ -478,7 +478,9 @@ fn report_input(
         },
         task: task_rows,
         tree,
-        distribution: Some(distribution),
+        // A run with no record yet (a CPU budget spent before its first alternative) has no
+        // level to plot.
+        distribution: (!s.levels.is_empty()).then_some(distribution),
         designs,
     }
 }

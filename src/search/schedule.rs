@@ -66,6 +66,7 @@ pub fn evaluate_units(
         .collect();
     let remaining: usize = todo.iter().map(|&u| undone(u).count()).sum();
     let work = Work {
+        spent: Spent::new(opts.budget.cpu_s, kept_cpu_s),
         task,
         plan,
         opts,
@@ -95,13 +96,12 @@ pub fn evaluate_units(
             });
         }),
         Strategy::Guided => {
-            let spent = Spent::new(opts.budget.cpu_s, kept_cpu_s);
             let mut todo = todo.clone();
             todo.sort_by_key(|&u| guide::rank(plan, u));
             // One score at a time: a parent's optimum is on record before its r1
             // children (one score lower) start, on any number of workers.
             for tier in todo.chunk_by(|&a, &b| unit_score(plan, a) == unit_score(plan, b)) {
-                in_order(&pool, tier, &spent, progress, |u| {
+                in_order(&pool, tier, &work.spent, progress, |u| {
                     let modes: Vec<u32> = undone(u).collect();
                     work.unit(u, &modes);
                 });
@@ -245,6 +245,10 @@ struct Work<'a> {
     robust_spec: Option<RobustSpec>,
     /// The optima warm starts come from (a guided search with warm starts).
     optima: Option<Optima>,
+    /// The CPU budget (a guided search's `--budget-cpu`): checked before each alternative,
+    /// not only before each model, so a run overshoots it by at most one alternative per
+    /// worker rather than by the models in flight.
+    spent: Spent,
 }
 
 impl Work<'_> {
@@ -304,7 +308,7 @@ impl Work<'_> {
         let key = self.plan.alternative(u, canonical).key();
         let shared = SharedStarts::new(alternative_seed(self.opts.seed, &key));
         for &m in members {
-            if self.progress.cancelled() {
+            if self.progress.cancelled() || self.spent.exhausted() {
                 return;
             }
             let alt = self.plan.alternative(u, m);
