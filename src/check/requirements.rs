@@ -24,7 +24,9 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::copies::{CopiedPattern, copy_crossings, with_copies};
-use super::distance::{apart_beyond, bounding_sphere, closest_on_triangle, triangle_distance};
+use super::distance::{
+    bounding_sphere, closest_on_triangle, projected_gap, sphere_gap, triangle_distance,
+};
 use super::rotated_copy::RotatedCopyError;
 use super::self_intersection::{CheckError, Checker};
 use super::shapes::facet_clearance;
@@ -456,22 +458,34 @@ pub fn judge_copies(copied: &CopiedPattern, n: usize) -> Result<CopiesReport, Ch
     let mut least: Option<f64> = None;
     for fr in &pat.frames {
         let tris = facet_triangles(&checker, &fr.coords);
-        // Spheres rule out the pairs that cannot beat the least so far (most of them once
-        // the first frame has set it); the answer is the same as testing every pair.
+        // Spheres rule out the pairs that cannot beat the least so far; taking the pairs
+        // nearest by their spheres first, the first gap past the least ends the frame. The
+        // answer is the same as testing every pair.
         let spheres: Vec<Vec<(V, f64)>> = tris
             .iter()
             .map(|ts| ts.iter().map(bounding_sphere).collect())
             .collect();
+        let mut near: Vec<(f64, &Tri, &Tri)> = Vec::new();
         for &(a, b) in &apart {
             for (ta, &sa) in tris[a].iter().zip(&spheres[a]) {
                 for (tb, &sb) in tris[b].iter().zip(&spheres[b]) {
-                    if least.is_some_and(|l| apart_beyond(sa, sb, l)) {
-                        continue;
+                    let gap = sphere_gap(sa, sb);
+                    if least.is_none_or(|l| gap <= l) {
+                        near.push((gap, ta, tb));
                     }
-                    let d = triangle_distance(ta, tb);
-                    least = Some(least.map_or(d, |l| l.min(d)));
                 }
             }
+        }
+        near.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for (gap, ta, tb) in near {
+            if least.is_some_and(|l| gap > l) {
+                break;
+            }
+            if least.is_some_and(|l| projected_gap(ta, tb) > l) {
+                continue;
+            }
+            let d = triangle_distance(ta, tb);
+            least = Some(least.map_or(d, |l| l.min(d)));
         }
     }
     Ok(CopiesReport {
