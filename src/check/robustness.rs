@@ -29,7 +29,9 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::cylinder::Cylinder;
-use super::distance::{SLACK, apart_beyond, bounding_sphere, point_segment_distance};
+use super::distance::{
+    SLACK, apart_beyond, bounding_sphere, point_segment_distance, projected_gap,
+};
 pub use super::distance::{segment_triangle_distance, triangle_distance};
 use super::features::{self, FeatureKind};
 use super::self_intersection::{CheckError, Checker};
@@ -438,8 +440,13 @@ impl<'a> State<'a> {
                 let mut d = f64::INFINITY;
                 for (a, sa) in tris[fa].iter().zip(&self.tri_spheres[fa]) {
                     for (b, sb) in tris[fb].iter().zip(&self.tri_spheres[fb]) {
-                        if !apart_beyond(*sa, *sb, d.min(least.value)) {
-                            d = d.min(triangle_distance(&self.tri(a), &self.tri(b)));
+                        let limit = d.min(least.value);
+                        if apart_beyond(*sa, *sb, limit) {
+                            continue;
+                        }
+                        let (a, b) = (self.tri(a), self.tri(b));
+                        if projected_gap(&a, &b) <= limit {
+                            d = d.min(triangle_distance(&a, &b));
                         }
                     }
                 }
