@@ -473,7 +473,7 @@ fn a_cpu_budget_is_checked_before_each_alternative() {
         ));
         let got = records(&out).len();
         assert!(
-            got <= jobs.parse().unwrap(),
+            got <= jobs.parse::<usize>().unwrap(),
             "{jobs} workers: {got} records"
         );
     }
