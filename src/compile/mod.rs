@@ -41,6 +41,7 @@ mod partials;
 pub mod simplify;
 #[cfg(feature = "symbolica")]
 pub mod symbolica;
+pub mod tape;
 pub mod vanish;
 pub mod vertex;
 

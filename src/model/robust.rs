@@ -8,8 +8,10 @@
 //! Cranelift), with the modes and `t` as parameters:
 //! - **values**: every vertex position, every Eq. 25 margin `U_j + U_k − U_i` and every
 //!   crease's fold angle at `t`;
-//! - **pullback**: `S = Σ w_i·X_i + Σ u_k m_k + Σ r_c ρ_c` with the weights as parameters,
-//!   and its gradient with respect to the design variables.
+//! - **pullback**: the gradient of `S = Σ w_i·X_i + Σ u_k m_k + Σ r_c ρ_c` with respect
+//!   to the design variables, with the weights as parameters. It reads the forward
+//!   quantities the values function left on a tape ([`crate::compile::tape`]) instead of
+//!   sweeping forward again.
 //!
 //! Every constraint of the block is a smooth function `h(X, m, ρ)` of those values (the
 //! separating-plane constraints of [`super::clearance`] are linear in `X` for a given
@@ -17,8 +19,8 @@
 //! `Σ_k ∂φ/∂h_k ∇h_k`, is the gradient of `S` with `w = Σ_k ∂φ/∂h_k ∂h_k/∂X`, etc.: one
 //! reverse sweep, exact (no finite differences), whatever the number of constraints. The
 //! compile cost does not grow with the number of facet pairs; each sampled state costs
-//! one call of each function per evaluation, and states with no constraint near its bound
-//! are skipped.
+//! one call of the values and, where a constraint is active, one of the pullback per
+//! evaluation, and states with no constraint near its bound are skipped.
 //!
 //! ## The constraints, at each sampled state t
 //!
@@ -61,10 +63,11 @@ use super::clearance::{
 };
 use super::select::{self, SelectError};
 use super::{Model, RIGID_MARGIN, geometry};
+use crate::compile::tape::Taped;
 use crate::compile::{self, Compiled, Options};
 use crate::expr::{Ctx, Sym};
 use crate::geom::V3;
-use crate::kinematics::{Scalar, wrap_angle};
+use crate::kinematics::wrap_angle;
 use crate::optimize::{Acceptance, Robust};
 use crate::scene::{Containment, HalfSpace};
 use crate::task::fabrication::Fabrication;
@@ -245,6 +248,10 @@ pub struct StateValues {
 pub struct Work {
     params: Vec<f64>,
     out: Vec<f64>,
+    /// The pullback's gradient.
+    grad: Vec<f64>,
+    /// Where the tape in `out` was computed: the free variables, the modes and t.
+    tape_at: Vec<f64>,
     x: Vec<V3>,
     /// The values of the last state evaluated.
     pub values: StateValues,
@@ -275,8 +282,8 @@ pub struct RobustModel {
     /// The flat layout's edges: every crease (tail, head), then the paper's edges that
     /// close open facets (as in the exported pattern).
     pub edges: Vec<[usize; 2]>,
-    values: Compiled,
-    pullback: Compiled,
+    /// Values and their weighted pullback, sharing a tape.
+    taped: Taped,
     /// In-plane positions of the flat layout and their Jacobian (issue 20).
     flat_fn: Compiled,
     n_vertices: usize,
@@ -342,30 +349,10 @@ impl RobustModel {
             value_ids.extend(p.iter().map(|s| ctx.node_id(s)));
         }
         value_ids.extend(m.iter().chain(&rho).map(|s| ctx.node_id(s)));
-        let mut p = ni + 1;
-        let mut s = Sym::from_f64(0.0);
-        for e in x.iter().flatten().chain(&m).chain(&rho) {
-            s = s + ctx.param(p) * e.clone();
-            p += 1;
-        }
-        let s_id = ctx.node_id(&s);
         let graph = ctx.to_graph();
-        let n_params = p;
-        let base = Options {
-            ..Options::default()
-        };
-        let values = compile::compile(
-            &graph,
-            &value_ids,
-            nf,
-            n_params,
-            &Options {
-                gradients: false,
-                ..base.clone()
-            },
-        )?;
-        let pullback = compile::compile(&graph, &[s_id], nf, n_params, &base)?;
-        let flat_fn = compile::compile(&graph, &flat_ids, nf, n_params, &base)?;
+        let base = Options::default();
+        let taped = compile::tape::taped(&graph, &value_ids, nf, ni + 1, base.simplify.as_ref())?;
+        let flat_fn = compile::compile(&graph, &flat_ids, nf, ni + 1, &base)?;
         Ok(RobustModel {
             pairs,
             creases,
@@ -374,8 +361,7 @@ impl RobustModel {
             boxes: spec.scene.containment.clone(),
             spec,
             edges: layout_edges(plan),
-            values,
-            pullback,
+            taped,
             flat_fn,
             n_vertices: nv,
             n_internal: ni,
@@ -499,20 +485,12 @@ impl RobustModel {
         3 * self.n_vertices + 3 * self.n_internal + self.creases.len()
     }
 
-    /// Sizes and times of the three compiled functions (values, pullback, flat layout).
-    pub fn reports(&self) -> [&compile::CompileReport; 3] {
-        [
-            &self.values.report,
-            &self.pullback.report,
-            &self.flat_fn.report,
-        ]
-    }
-
     /// Buffers sized for this block.
     pub fn work(&self) -> Work {
         Work {
-            params: vec![0.0; self.n_internal + 1 + self.n_weights()],
-            out: vec![0.0; self.values.layout.len().max(self.pullback.layout.len())],
+            params: vec![0.0; self.n_internal + 1 + self.n_weights() + self.taped.n_tape],
+            out: vec![0.0; self.taped.n_values + self.taped.n_tape],
+            grad: vec![0.0; self.taped.reverse.n_outputs()],
             weights: vec![0.0; self.n_weights()],
             flat: vec![[0.0; 2]; self.n_vertices],
             flat_out: vec![0.0; self.flat_fn.layout.len()],
@@ -526,11 +504,13 @@ impl RobustModel {
         let ni = self.n_internal;
         work.params[..ni].copy_from_slice(modes);
         work.params[ni] = t;
-        let len = self.values.layout.len();
-        self.values
-            .function
-            .call(free, &work.params, &mut work.out[..len])
+        self.taped
+            .forward
+            .call(free, &work.params[..ni + 1], &mut work.out)
             .expect("buffer sizes match the compiled layout");
+        work.tape_at.clear();
+        work.tape_at.extend_from_slice(free);
+        work.tape_at.extend_from_slice(&work.params[..ni + 1]);
         let nv = self.n_vertices;
         work.x.clear();
         work.x
@@ -580,18 +560,23 @@ impl RobustModel {
         grad: &mut [f64],
     ) {
         let ni = self.n_internal;
-        work.params[..ni].copy_from_slice(modes);
-        work.params[ni] = t;
-        work.params[ni + 1..].copy_from_slice(weights);
-        let len = self.pullback.layout.len();
-        self.pullback
-            .function
-            .call(free, &work.params, &mut work.out[..len])
+        // The tape is the last `eval`'s: evaluate first unless it was at this point.
+        let (nf, at) = (free.len(), &work.tape_at);
+        let same = at.len() == nf + ni + 1
+            && at[..nf] == *free
+            && at[nf..nf + ni] == *modes
+            && at[nf + ni] == t;
+        if !same {
+            self.eval(free, modes, t, work);
+        }
+        let (nv, nt) = (self.taped.n_values, self.taped.n_tape);
+        work.params[ni + 1..ni + 1 + nv].copy_from_slice(weights);
+        work.params[ni + 1 + nv..].copy_from_slice(&work.out[nv..nv + nt]);
+        self.taped
+            .reverse
+            .call(free, &work.params, &mut work.grad)
             .expect("buffer sizes match the compiled layout");
-        for (g, d) in grad
-            .iter_mut()
-            .zip(&work.out[self.pullback.layout.gradient(0)])
-        {
+        for (g, d) in grad.iter_mut().zip(&work.grad) {
             *g += d;
         }
     }
@@ -857,7 +842,11 @@ impl RobustModel {
         let n = self.n_vertices;
         self.flat_fn
             .function
-            .call(free, &work.params, &mut work.flat_out)
+            .call(
+                free,
+                &work.params[..self.n_internal + 1],
+                &mut work.flat_out,
+            )
             .expect("buffer sizes match the compiled layout");
         work.flat.clear();
         work.flat
