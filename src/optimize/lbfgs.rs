@@ -51,7 +51,9 @@ pub(super) fn minimize(f: &mut impl Smooth, y0: &[f64], s: &Settings) -> Vec<f64
     let mut prev_cost = f64::INFINITY;
     let mut best = param.clone();
     let mut best_cost = cost;
-    let mut pairs: VecDeque<(Vec<f64>, Vec<f64>)> = VecDeque::with_capacity(s.memory);
+    // (s, y, yᵀs, yᵀy): dot products argmin recomputes every iteration, computed once
+    // when the pair is stored (the same bits: each product commutes, the order is kept).
+    let mut pairs: VecDeque<(Vec<f64>, Vec<f64>, f64, f64)> = VecDeque::with_capacity(s.memory);
     let (mut q, mut d) = (vec![0.0; n], vec![0.0; n]);
     let (mut alpha, mut rho) = (vec![0.0; s.memory + 1], vec![0.0; s.memory + 1]);
     let (mut x1, mut g1) = (vec![0.0; n], vec![0.0; n]);
@@ -73,13 +75,13 @@ pub(super) fn minimize(f: &mut impl Smooth, y0: &[f64], s: &Settings) -> Vec<f64
         }
         // The two-loop recursion.
         let gamma = match pairs.back() {
-            Some((sk, yk)) => dot(sk, yk) / dot(yk, yk),
+            Some((_, _, sy, yy)) => sy / yy,
             None => 1.0,
         };
         q.copy_from_slice(&grad);
         let m = pairs.len();
-        for (i, (sk, yk)) in pairs.iter().rev().enumerate() {
-            let rho_t = 1.0 / dot(yk, sk);
+        for (i, (sk, yk, sy, _)) in pairs.iter().rev().enumerate() {
+            let rho_t = 1.0 / sy;
             let alpha_t = dot(sk, &q) * rho_t;
             for (qj, y) in q.iter_mut().zip(yk) {
                 *qj -= y * alpha_t;
@@ -90,7 +92,7 @@ pub(super) fn minimize(f: &mut impl Smooth, y0: &[f64], s: &Settings) -> Vec<f64
         for qj in q.iter_mut() {
             *qj *= gamma;
         }
-        for (i, (sk, yk)) in pairs.iter().enumerate() {
+        for (i, (sk, yk, _, _)) in pairs.iter().enumerate() {
             let beta = dot(yk, &q) * rho[i];
             for (r, s) in q.iter_mut().zip(sk) {
                 *r += s * (alpha[i] - beta);
@@ -110,12 +112,14 @@ pub(super) fn minimize(f: &mut impl Smooth, y0: &[f64], s: &Settings) -> Vec<f64
         } else {
             None
         };
-        let (mut sk, mut yk) = recycled.unwrap_or_else(|| (vec![0.0; n], vec![0.0; n]));
+        let (mut sk, mut yk, ..) =
+            recycled.unwrap_or_else(|| (vec![0.0; n], vec![0.0; n], 0.0, 0.0));
         for j in 0..n {
             sk[j] = x1[j] - param[j];
             yk[j] = g1[j] - grad[j];
         }
-        pairs.push_back((sk, yk));
+        let (sy, yy) = (dot(yk.as_slice(), &sk), dot(&yk, &yk));
+        pairs.push_back((sk, yk, sy, yy));
         std::mem::swap(&mut param, &mut x1);
         std::mem::swap(&mut grad, &mut g1);
         prev_cost = cost;
