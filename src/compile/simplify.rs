@@ -417,7 +417,11 @@ pub fn dag_cost(graph: &ExprGraph, outputs: &[NodeId]) -> f64 {
 /// Limits of one simplification run.
 #[derive(Clone, Debug)]
 pub struct Limits {
-    /// Rule-application iterations.
+    /// Rule-application iterations. Default 4: on the robotic arm's model
+    /// `2, 4, 6, (3, 9), (6, 10)` four give the same 4,130 operations as eight in 16 ms
+    /// of egg instead of 28 (`bench model`, one sitting); the gripper's search at N_max = 3
+    /// gives the same records bit for bit, the arm's compile stage 8.7 → 7.6 CPU s with
+    /// 105 designs instead of 103 (its seed spread is 103–113; 6 Dec 2026).
     pub iterations: usize,
     /// E-graph size limit in e-nodes, as a multiple of the input's node count.
     pub node_factor: usize,
@@ -433,7 +437,7 @@ pub struct Limits {
 impl Default for Limits {
     fn default() -> Self {
         Limits {
-            iterations: 8,
+            iterations: 4,
             node_factor: 6,
             min_nodes: 5_000,
             time: Duration::from_secs(2),
