@@ -13,7 +13,6 @@ use super::codegen::{CompileError, Math, OptLevel};
 use super::diff::gradient;
 use super::jit::CompiledFn;
 use super::simplify;
-use crate::cpu_time::Stopwatch;
 use crate::expr::{ExprGraph, Node, NodeId, check_indices};
 use std::collections::HashMap;
 
@@ -31,13 +30,9 @@ pub struct Taped {
     pub n_values: usize,
     /// Number of tape entries.
     pub n_tape: usize,
-    /// Number of the model's own parameters (the weights follow them in `reverse`).
-    pub n_params: usize,
     /// Operations of the values alone (after simplification), of the forward function
     /// and of the reverse function.
     pub ops: [usize; 3],
-    /// CPU milliseconds in simplification, differentiation and code generation.
-    pub ms: [f64; 3],
 }
 
 /// Compile `values` over `n_vars` variables and `n_params` parameters, and the gradient of
@@ -50,7 +45,6 @@ pub fn taped(
     limits: Option<&simplify::Limits>,
 ) -> Result<Taped, CompileError> {
     check_indices(graph, values, n_vars, n_params)?;
-    let t0 = Stopwatch::start();
     let (mut g, outs) = match limits {
         Some(l) => {
             let (g, o, _) = simplify::simplify(graph, values, l);
@@ -58,8 +52,6 @@ pub fn taped(
         }
         None => graph.extract(values),
     };
-    let simplify_ms = t0.cpu_ms();
-    let t1 = Stopwatch::start();
     let value_ops = g.counts(&outs).ops;
     let mut s = g.constant(0.0);
     for (k, &v) in outs.iter().enumerate() {
@@ -69,8 +61,6 @@ pub fn taped(
     }
     let grad = gradient(&mut g, s, n_vars)?;
     let (reverse_graph, reverse_outs, tape) = split(&g, &grad, n_params, values.len());
-    let diff_ms = t1.cpu_ms();
-    let t2 = Stopwatch::start();
     let mut fwd_outs = outs.clone();
     fwd_outs.extend(&tape);
     // The values keep the interpreter's bits; the reverse sweep is all gradient (fused
@@ -94,19 +84,16 @@ pub fn taped(
         Math::Batch,
         0,
     )?;
-    let jit_ms = t2.cpu_ms();
     Ok(Taped {
         forward,
         reverse,
         n_values: values.len(),
         n_tape: tape.len(),
-        n_params,
         ops: [
             value_ops,
             g.counts(&fwd_outs).ops,
             reverse_graph.counts(&reverse_outs).ops,
         ],
-        ms: [simplify_ms, diff_ms, jit_ms],
     })
 }
 
