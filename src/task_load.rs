@@ -49,6 +49,7 @@ impl Task {
     pub fn from_toml_str_in(text: &str, file: &str, dir: &Path) -> Result<Task, TaskError> {
         let mut draft = Draft::parse(text, file)?;
         check_facets(&draft.cx, &draft.initial)?;
+        draft.actuate()?;
         if draft.symmetry.mirror_xz {
             draft.initial.mirror = Some(mirror_map(&draft.cx, &draft.initial, draft.tol)?);
             check_mirror_order(&draft.cx, &draft.initial)?;

@@ -28,6 +28,8 @@ pub struct CreaseGraph {
     pub(super) variables: Vec<Variable>,
     pub(super) steps: Vec<StepRecord>,
     pub(super) extension_order: Vec<Vid>,
+    /// Orbits under the pattern's symmetry group (`None` without one).
+    pub(super) sym: Option<super::symmetric::SymState>,
 }
 
 /// One ray of the rotation around a vertex.
@@ -118,6 +120,10 @@ impl CreaseGraph {
             );
             edge_of.push(e);
         }
+        let sym = init
+            .group
+            .as_ref()
+            .map(super::symmetric::SymState::of_initial);
         CreaseGraph {
             order: (0..init.vertices.len()).map(|i| Vid(i as u32)).collect(),
             facet_names: init.facets.clone(),
@@ -128,6 +134,7 @@ impl CreaseGraph {
             variables: Vec::new(),
             steps: Vec::new(),
             extension_order: Vec::new(),
+            sym,
         }
     }
 
@@ -260,14 +267,38 @@ impl CreaseGraph {
         &self.extension_order
     }
 
-    /// Number of internal (extended) vertices, N.
+    /// Number of internal (extended) vertices N as the grammar counts them (what N_max
+    /// limits, and 2^N mode assignments): with a pattern symmetry, the extended orbits
+    /// (each stands for all its images); otherwise every extended vertex.
     pub fn internal_count(&self) -> usize {
+        match &self.sym {
+            Some(s) => self
+                .extension_order
+                .iter()
+                .filter(|v| s.is_rep(**v))
+                .count(),
+            None => self.extension_order.len(),
+        }
+    }
+
+    /// Number of extended vertices of the whole pattern, images included (each has its
+    /// own PTU).
+    pub fn extended_count(&self) -> usize {
         self.extension_order.len()
     }
 
-    /// The vertex extended last (the mark the isomorphism filter respects).
+    /// The vertex extended last (the mark the isomorphism filter respects); with a pattern
+    /// symmetry, the representative of the orbit extended last.
     pub fn last_extended(&self) -> Option<Vid> {
-        self.extension_order.last().copied()
+        match &self.sym {
+            Some(s) => self
+                .extension_order
+                .iter()
+                .rev()
+                .find(|v| s.is_rep(**v))
+                .copied(),
+            None => self.extension_order.last().copied(),
+        }
     }
 
     /// The gripping candidates: the current heads of the three creases of the vertex
@@ -296,7 +327,11 @@ impl CreaseGraph {
                 seen[self.g[n].vid.ix()] = true;
             }
         }
-        self.extension_order.iter().all(|v| seen[v.ix()])
+        // With a symmetry, an orbit is an ancestor when any of its members is.
+        self.extension_order.iter().all(|v| match &self.sym {
+            Some(s) => s.orbit(*v).iter().any(|u| seen[u.ix()]),
+            None => seen[v.ix()],
+        })
     }
 
     /// Number of design alternatives this graph gives: 2^N RBM assignments × its gripping
@@ -563,8 +598,9 @@ impl CreaseGraph {
                     }
                 }
                 // r2′ closes a straight angle at its sink: nothing to bound (its Eq. 31–32
-                // constraints stay on the creases' ends, measured, as for r2).
-                StepRecord::R2(r) if r.straight.is_some() => {}
+                // constraints stay on the creases' ends, measured, as for r2). An image of a
+                // representative's step repeats its constraint exactly.
+                StepRecord::R2(r) if r.straight.is_some() || r.image => {}
                 StepRecord::R2(r) => {
                     if let ConstraintSpec::MergedSector { from, to, .. } = r.constraint {
                         out.push(ConstraintSpec::MergedSector {

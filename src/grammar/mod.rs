@@ -86,6 +86,7 @@ mod notation;
 mod rules;
 mod step;
 mod straight;
+mod symmetric;
 
 pub use canon::Code;
 pub use enumerate::{
@@ -356,8 +357,9 @@ pub struct Created {
     pub vertex: Vid,
     /// The new crease.
     pub crease: Cid,
-    /// Its placement.
-    pub placement: Placement,
+    /// Its placement; `None` for the image of a representative's vertex under the
+    /// pattern's symmetry (placed as that image, with the representative's variables).
+    pub placement: Option<Placement>,
 }
 
 /// One application of r1.
@@ -375,6 +377,10 @@ pub struct R1Record {
     pub variables: Vec<VarId>,
     /// The constraints introduced (as created).
     pub constraints: Vec<ConstraintSpec>,
+    /// Whether this application extends an image of an orbit's representative under the
+    /// pattern's symmetry (it follows the representative's step, adds no variable and no
+    /// constraint, and is not written in the rule sequence).
+    pub image: bool,
 }
 
 /// One application of r2.
@@ -405,6 +411,10 @@ pub struct R2Record {
     /// `Some` when this application was r2′ (the combined vertex is a sink on the straight
     /// segment between the predecessors).
     pub straight: Option<Straight>,
+    /// Whether this application combines images of a representative pair under the
+    /// pattern's symmetry (it follows that pair's step and is not written in the rule
+    /// sequence).
+    pub image: bool,
 }
 
 /// What r2′ did beyond r2 (thesis Sec. 5.7, Fig. 52b): both combined vertices give way to

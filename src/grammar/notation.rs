@@ -150,6 +150,10 @@ impl CreaseGraph {
     pub fn sequence_steps(&self) -> Vec<Step> {
         self.steps
             .iter()
+            .filter(|s| match s {
+                StepRecord::R1(r) => !r.image,
+                StepRecord::R2(r) => !r.image,
+            })
             .map(|s| match s {
                 StepRecord::R1(r) => Step::Extend(r.name),
                 StepRecord::R2(r) if r.straight.is_some() => Step::Straight(r.names.0, r.names.1),

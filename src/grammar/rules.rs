@@ -102,10 +102,12 @@ fn r1_constraints(
         to: rt,
     });
     for c in created {
-        constraints.push(ConstraintSpec::Length {
-            crease: c.crease,
-            var: Some(c.placement.length),
-        });
+        if let Some(p) = &c.placement {
+            constraints.push(ConstraintSpec::Length {
+                crease: c.crease,
+                var: Some(p.length),
+            });
+        }
     }
     constraints.push(ConstraintSpec::RigidFoldability { vertex: a });
     constraints
@@ -141,8 +143,23 @@ impl CreaseGraph {
     /// Rule r1: give χ vertex `a` its missing outgoing creases s1, s2, s3 (all six scenarios
     /// of Tables 1–2: the slots G0 already filled stay), place the new vertices (Eq. 28) with
     /// new sector and length variables, record the constraints (Eq. 31–33), and make `a`
-    /// internal (type ∅).
+    /// internal (type ∅). With a pattern symmetry, `a` must represent its orbit, and every
+    /// image of `a` is extended with it (`grammar::symmetric`).
     pub fn extend(&mut self, a: Vid) -> Result<(), RuleError> {
+        if self.sym.is_some() {
+            return self.extend_orbit(a);
+        }
+        self.extend_one(a, None)
+    }
+
+    /// r1 on `a` alone. `image`: `a` is the image under element `g` of `source`, which was
+    /// just extended: every new crease and vertex is the image of `source`'s (same
+    /// variables, no new ones, no constraints of its own).
+    pub(super) fn extend_one(
+        &mut self,
+        a: Vid,
+        image: Option<(Vid, usize)>,
+    ) -> Result<(), RuleError> {
         self.check_extend(a)?;
         let step = self.steps.len();
         let aname = self.name(a).expect("living");
@@ -178,24 +195,42 @@ impl CreaseGraph {
         let mut sector_of = [None::<VarId>; 3];
         for (i, &k) in missing.iter().enumerate() {
             let last_new = i + 1 == missing.len();
+            // The crease of the source this one is the image of: a reflection reverses the
+            // rotation, so slot s1 is the image of the source's s3.
+            let mirrored = image.map(|(src, g)| {
+                let ks = if self.group().expect("symmetric").reflects(g) {
+                    2 - k
+                } else {
+                    k
+                };
+                let sc = self.vx(src).slots[ks].expect("the source was extended first");
+                (sc, g)
+            });
             let (c, left) = self.r1_crease(
                 &at,
                 k,
                 sector_of[0],
                 last_new.then_some(after_facet),
                 right_facet,
+                mirrored,
             );
-            // The crease's own sector is the last its placement sums.
-            let sector = *c.placement.sectors.last().expect("a sector");
-            variables.extend([sector, c.placement.length]);
-            sector_of[k] = Some(sector);
+            if let Some(p) = &c.placement {
+                // The crease's own sector is the last its placement sums.
+                let sector = *p.sectors.last().expect("a sector");
+                variables.extend([sector, p.length]);
+                sector_of[k] = Some(sector);
+            }
             right_facet = left;
             slots[k] = Some(c.crease);
             created.push(c);
         }
         let s = slots.map(|c| c.expect("all slots filled"));
         let remainder_s1_s2 = sector_of[0].is_some() && v.slots[1].is_some();
-        let constraints = r1_constraints(a, (p1, pm), s, sector_of, remainder_s1_s2, &created);
+        let constraints = if image.is_some() {
+            Vec::new()
+        } else {
+            r1_constraints(a, (p1, pm), s, sector_of, remainder_s1_s2, &created)
+        };
 
         let va = self.vx_mut(a);
         va.slots = slots;
@@ -209,6 +244,7 @@ impl CreaseGraph {
             created,
             variables,
             constraints,
+            image: image.is_some(),
         }));
         Ok(())
     }
@@ -234,7 +270,9 @@ impl CreaseGraph {
     /// r1's new crease in slot `k` (0-based) of `at.a`, with its new vertex, its sector and
     /// length variables and its placement (Eq. 28). `s1_sector`: the sector variable of an
     /// s1 created in the same application; `left`: the facet on its left, `None` for a new
-    /// one. Returns what was created and the facet on its left.
+    /// one; `image`: the crease this one is the image of under a symmetry element (then it
+    /// takes that crease's variables and has no placement). Returns what was created and
+    /// the facet on its left.
     fn r1_crease(
         &mut self,
         at: &R1Parent,
@@ -242,50 +280,60 @@ impl CreaseGraph {
         s1_sector: Option<VarId>,
         left: Option<FacetId>,
         right: FacetId,
+        image: Option<(Cid, usize)>,
     ) -> (Created, FacetId) {
         let (a, step) = (at.a, at.step);
         let vid = Vid(self.node_of.len() as u32);
         let vname = self.order.len() + 1;
         let cid = Cid(self.edge_of.len() as u32);
-        let sector = self.new_var(VarKind::Sector, format!("α_{vname}"), step, cid, vid);
-        let length = self.new_var(
-            VarKind::Length,
-            format!("l_{},{vname}", at.aname),
-            step,
-            cid,
-            vid,
-        );
-        let placement = match k {
-            0 => Placement {
-                parent: a,
-                reference: at.ref_pm,
-                sign: 1.0,
-                sectors: vec![sector],
-                length,
+        let (sector, length, placement) = match image {
+            Some((sc, _)) => match self.cr(sc).origin {
+                CreaseOrigin::Extension { sector, length, .. } => (sector, length, None),
+                CreaseOrigin::Initial { .. } => unreachable!("r1 images r1's creases"),
             },
-            1 => match at.s1 {
-                Some(s1) => Placement {
-                    parent: a,
-                    reference: self.cr(s1).head,
-                    sign: 1.0,
-                    sectors: vec![sector],
-                    length,
-                },
-                None => Placement {
-                    parent: a,
-                    reference: at.ref_pm,
-                    sign: 1.0,
-                    sectors: vec![s1_sector.expect("s1 created first"), sector],
-                    length,
-                },
-            },
-            _ => Placement {
-                parent: a,
-                reference: at.ref_p1,
-                sign: -1.0,
-                sectors: vec![sector],
-                length,
-            },
+            None => {
+                let sector = self.new_var(VarKind::Sector, format!("α_{vname}"), step, cid, vid);
+                let length = self.new_var(
+                    VarKind::Length,
+                    format!("l_{},{vname}", at.aname),
+                    step,
+                    cid,
+                    vid,
+                );
+                let placement = match k {
+                    0 => Placement {
+                        parent: a,
+                        reference: at.ref_pm,
+                        sign: 1.0,
+                        sectors: vec![sector],
+                        length,
+                    },
+                    1 => match at.s1 {
+                        Some(s1) => Placement {
+                            parent: a,
+                            reference: self.cr(s1).head,
+                            sign: 1.0,
+                            sectors: vec![sector],
+                            length,
+                        },
+                        None => Placement {
+                            parent: a,
+                            reference: at.ref_pm,
+                            sign: 1.0,
+                            sectors: vec![s1_sector.expect("s1 created first"), sector],
+                            length,
+                        },
+                    },
+                    _ => Placement {
+                        parent: a,
+                        reference: at.ref_p1,
+                        sign: -1.0,
+                        sectors: vec![sector],
+                        length,
+                    },
+                };
+                (sector, length, Some(placement))
+            }
         };
         let left = match left {
             Some(f) => f,
@@ -299,7 +347,7 @@ impl CreaseGraph {
             extended: false,
             g0: None,
             g0_coords: None,
-            placement: Some(placement.clone()),
+            placement: placement.clone(),
             sink_between: None,
         });
         self.node_of.push(Some(node));
@@ -323,6 +371,16 @@ impl CreaseGraph {
             },
         );
         self.edge_of.push(e);
+        if self.sym.is_some() {
+            let source = image.map(|(sc, g)| {
+                let sv = match self.cr(sc).origin {
+                    CreaseOrigin::Extension { created, .. } => created,
+                    CreaseOrigin::Initial { .. } => unreachable!("r1 images r1's creases"),
+                };
+                (sv, sc, g)
+            });
+            self.sym_register(vid, cid, source);
+        }
         let created = Created {
             slot: k as u8 + 1,
             vertex: vid,
@@ -485,6 +543,15 @@ impl CreaseGraph {
     /// survivor's predecessors become preds(c1) then preds(c2), later names shift down.
     /// Records Eq. 34 and the variables eliminated with their substitutes (Eq. 35).
     pub fn combine(&mut self, m: R2Match) -> Result<(), RuleError> {
+        if self.sym.is_some() {
+            return self.combine_orbit(m);
+        }
+        self.combine_one(m, false)
+    }
+
+    /// r2 on one pair; `image`: the pair is an image of a representative pair just
+    /// combined (recorded, not written in the sequence).
+    pub(super) fn combine_one(&mut self, m: R2Match, image: bool) -> Result<(), RuleError> {
         self.check_combine(m.c1, m.c2)?;
         let names = self.pair_names(m, self.r2_reason(m.c2, m.c1).is_ok());
         let a = self.vx(m.c1).clone();
@@ -549,6 +616,7 @@ impl CreaseGraph {
                 to,
             },
             straight: None,
+            image,
         }));
         Ok(())
     }
@@ -568,7 +636,7 @@ impl CreaseGraph {
                 .created
                 .iter()
                 .find(|c| c.crease == v.crease)
-                .map(|c| c.placement.clone())
+                .and_then(|c| c.placement.clone())
                 .expect("the r1 step created the variable's crease"),
             StepRecord::R2(_) => unreachable!("variables come from r1 steps"),
         };
@@ -594,12 +662,16 @@ impl CreaseGraph {
         }
         self.vertices()
             .filter(|v| v.ty == VertexType::Extendable)
+            .filter(|v| self.sym.as_ref().is_none_or(|s| s.is_rep(v.vid)))
             .map(|v| v.vid)
             .collect()
     }
 
     /// The r2 matches in increasing order of their sorted name pairs, with their notation.
     pub fn r2_matches(&self) -> Vec<(Step, R2Match)> {
+        if self.sym.is_some() {
+            return self.orbit_pair_matches(false);
+        }
         self.pair_matches(
             |v| v.ty == VertexType::Extendable,
             |a, b| self.r2_reason(a, b).is_ok(),

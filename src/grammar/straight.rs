@@ -37,7 +37,7 @@ pub type StraightSink = R2Match;
 
 /// Why r2′ does not match.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum NoR2p {
+pub(super) enum NoR2p {
     /// r2's own condition fails.
     R2(NoR2),
     /// One vertex is a predecessor of the other (it is extended, hence ∅).
@@ -53,7 +53,7 @@ enum NoR2p {
 }
 
 impl CreaseGraph {
-    fn r2p_reason(&self, c1: Vid, c2: Vid) -> Result<(), NoR2p> {
+    pub(super) fn r2p_reason(&self, c1: Vid, c2: Vid) -> Result<(), NoR2p> {
         // "r2′ on a predecessor": name it before r2's generic "not extendable".
         for (x, y) in [(c1, c2), (c2, c1)] {
             if x != y && self.vx(y).preds.iter().any(|&c| self.cr(c).tail == x) {
@@ -143,6 +143,14 @@ impl CreaseGraph {
     /// Rule r2′: replace c1 and c2 by a sink v′ at the midpoint of their predecessors (see
     /// the module docs). Records the step as an [`R2Record`] with [`Straight`] set.
     pub fn combine_straight(&mut self, m: StraightSink) -> Result<(), RuleError> {
+        if self.sym.is_some() {
+            return self.straight_orbit(m);
+        }
+        self.straight_one(m, false)
+    }
+
+    /// r2′ on one pair; `image`: an image of a representative pair just combined.
+    pub(super) fn straight_one(&mut self, m: StraightSink, image: bool) -> Result<(), RuleError> {
         self.check_combine_straight(m.c1, m.c2)?;
         let names = self.pair_names(m, self.r2p_reason(m.c2, m.c1).is_ok());
         let a = self.vx(m.c1).clone();
@@ -233,6 +241,7 @@ impl CreaseGraph {
                 outer,
                 merged_name,
             }),
+            image,
         }));
         Ok(())
     }
@@ -255,6 +264,9 @@ impl CreaseGraph {
     /// The r2′ matches in increasing order of their sorted name pairs, with their notation
     /// (r2′ off: the enumeration does not ask).
     pub fn r2p_matches(&self) -> Vec<(Step, StraightSink)> {
+        if self.sym.is_some() {
+            return self.orbit_pair_matches(true);
+        }
         self.pair_matches(
             |v| v.ty == VertexType::Extendable && v.preds.len() == 1 && !v.in_g0(),
             |a, b| self.r2p_reason(a, b).is_ok(),

@@ -67,6 +67,49 @@ pub struct InitialGraph {
     /// For tasks symmetric about the xz-plane: the mirror image (x, y) → (x, −y) of every
     /// vertex and facet.
     pub mirror: Option<MirrorMap>,
+    /// The driven creases between two extendable vertices (the thesis's double-sided
+    /// arrows, Fig. 32), each split at its midpoint into two halves driven from a terminal
+    /// source there, in the order the task file gives them.
+    pub split: Vec<SplitSide>,
+    /// How the drives move the paper.
+    pub actuation: G0Actuation,
+    /// The pattern's symmetry group (`[symmetry] rotations`, `mirror_axis`): the grammar
+    /// grows one orbit representative and its images follow; `None` without one.
+    pub group: Option<super::symmetry::Group>,
+}
+
+/// A driven crease between two extendable vertices, incoming at both ends: G0 holds it as
+/// two collinear halves from a terminal source at its midpoint, so that each end gets the
+/// drive as an incoming crease and the graph stays acyclic.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SplitSide {
+    /// The crease as the task file gives it (index into its `[[initial_graph.creases]]`).
+    pub file_index: usize,
+    /// Its ends as written: `from`, `to` (vertex indices).
+    pub ends: [usize; 2],
+    /// The midpoint source (vertex index, after the task's own vertices).
+    pub mid: usize,
+    /// The halves mid → `to` and mid → `from` (crease indices).
+    pub halves: [usize; 2],
+}
+
+/// How G0's driven creases move the paper (SPEC §4, §7).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum G0Actuation {
+    /// The driven creases lie on one straight line between the same two facets (the
+    /// thesis's gripper and arm: one crease): the facet left of crease `crease` turns by
+    /// +ρ/2 about it, the facet right of it by −ρ/2.
+    Split {
+        /// A driven crease (any of them: they are collinear).
+        crease: usize,
+    },
+    /// One facet stays fixed (the central facet of Sec. 3.4 and 4.3, or the facet the task
+    /// names with `initial_graph.fixed`) and every facet across a driven crease from it
+    /// turns about that crease by its driving angle.
+    Fixed {
+        /// The fixed facet.
+        facet: usize,
+    },
 }
 
 /// The mirror image of G0's vertices and facets.
@@ -88,6 +131,8 @@ pub(crate) struct RawInitial {
     pub(crate) vertices: Vec<RawVertex>,
     #[serde(default)]
     pub(crate) creases: Vec<RawCrease>,
+    /// The facet that stays fixed while the drives fold the paper.
+    pub(crate) fixed: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -129,11 +174,11 @@ pub(crate) struct RawCrease {
 // ---------------------------------------------------------------------------------------
 // Checks.
 
-fn vf(i: usize) -> String {
+pub(super) fn vf(i: usize) -> String {
     format!("initial_graph.vertices[{i}]")
 }
 
-fn cf(i: usize) -> String {
+pub(super) fn cf(i: usize) -> String {
     format!("initial_graph.creases[{i}]")
 }
 
@@ -155,8 +200,10 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial) -> Result<(InitialGraph, f64
     }
     let (mut vertices, index) = vertices(cx, raw)?;
     let tol = distinct_positions(cx, &vertices)?;
-    let (creases, facets) = creases(cx, raw, &index)?;
+    let (mut creases, facets) = creases(cx, raw, &index)?;
     check_drives(cx, &vertices, &creases, raw)?;
+    check_simple(cx, &vertices, &creases, raw, tol)?;
+    let split = super::actuation::split_sides(&mut vertices, &mut creases, raw);
     check_topology(cx, &vertices, &creases)?;
 
     // The counter-clockwise order around every vertex.
@@ -164,11 +211,17 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial) -> Result<(InitialGraph, f64
         let ring = ring_at(cx, &vertices, &creases, vi)?;
         order_vertex(cx, &mut vertices, &creases, &facets, vi, ring)?;
     }
+    super::actuation::check_corners(cx, &vertices, &creases)?;
+    // Filled in by `Draft::actuate`, after the facet labels are checked.
+    let actuation = G0Actuation::Split { crease: 0 };
     let g = InitialGraph {
         vertices,
         creases,
         facets,
         mirror: None,
+        split,
+        actuation,
+        group: None,
     };
     Ok((g, tol))
 }
@@ -314,17 +367,25 @@ fn creases(
     Ok((creases, facets))
 }
 
-/// Extendable vertices have incoming creases; exactly the creases leaving terminal
-/// vertices are driven.
+/// Extendable vertices have incoming creases; the creases leaving terminal vertices are
+/// driven, and so may be creases between two extendable vertices (driven from both ends);
+/// no other crease takes a drive (the PTU gives its angle), and every drive starts flat.
 fn check_drives(
     cx: &Ctx<'_>,
     vertices: &[InitialVertex],
     creases: &[InitialCrease],
     raw: &RawInitial,
 ) -> Result<(), TaskError> {
-    // An extendable vertex needs incoming creases: r1 places new creases from p1 and pm.
+    // An extendable vertex needs incoming creases: r1 places new creases from p1 and pm. A
+    // crease driven from both ends counts as incoming at both.
     for (i, v) in vertices.iter().enumerate() {
-        if v.ty == VertexType::Extendable && !creases.iter().any(|c| c.head == i) {
+        let incoming = creases.iter().any(|c| {
+            c.head == i
+                || (c.tail == i
+                    && c.drive.is_some()
+                    && vertices[c.head].ty == VertexType::Extendable)
+        });
+        if v.ty == VertexType::Extendable && !incoming {
             return Err(cx.err(
                 format!("{}.type", vf(i)),
                 format!("vertex \"{}\" has no incoming crease (a source) and cannot be extendable: make it \"terminal\"", v.id),
@@ -333,9 +394,11 @@ fn check_drives(
     }
     for (i, (c, raw)) in creases.iter().zip(&raw.creases).enumerate() {
         // A crease leaving a terminal vertex is driven: its angle is prescribed. A crease
-        // leaving an extendable vertex gets its angle from the PTU when the tail is extended.
-        match (vertices[c.tail].ty, &c.drive) {
-            (VertexType::Terminal, None) => {
+        // leaving an extendable vertex gets its angle from the PTU when the tail is
+        // extended, unless it is driven and ends at an extendable vertex too: then the drive
+        // enters both ends (the thesis's double-sided arrows, Fig. 32).
+        match (vertices[c.tail].ty, vertices[c.head].ty, &c.drive) {
+            (VertexType::Terminal, _, None) => {
                 return Err(cx.err(
                     format!("{}.drive", cf(i)),
                     format!(
@@ -344,19 +407,115 @@ fn check_drives(
                     ),
                 ));
             }
-            (VertexType::Extendable, Some(_)) => {
+            (VertexType::Extendable, VertexType::Terminal, Some(_)) => {
                 return Err(cx.err(
                     format!("{}.drive", cf(i)),
                     format!(
-                        "crease {} → {} leaves extendable vertex \"{}\"; its angle follows from the PTU once \"{}\" is extended, so it takes no drive",
-                        raw.from, raw.to, raw.from, raw.from
+                        "crease {} → {} leaves extendable vertex \"{}\" and ends at terminal \"{}\": its angle follows from the PTU once \"{}\" is extended, so it takes no drive (a drive belongs on a crease leaving a terminal vertex, or on a crease between two extendable vertices, which the drive then enters at both ends)",
+                        raw.from, raw.to, raw.from, raw.to, raw.from
                     ),
                 ));
             }
             _ => {}
         }
+        if let Some(d) = &c.drive {
+            let at0: f64 = d.eval(&0.0);
+            if !at0.is_finite() || at0.abs() > 1e-12 {
+                return Err(cx.err(
+                    format!("{}.drive", cf(i)),
+                    format!(
+                        "\"{d}\" is {} at t = 0: the paper starts flat, so every driving angle must be 0 at t = 0 (e.g. \"t\", \"-t\", \"t/1.2\")",
+                        crate::text::num(at0)
+                    ),
+                ));
+            }
+        }
     }
     Ok(())
+}
+
+/// G0 must be drawn without crossings: two creases meet only at a common end (a closed
+/// chain of creases, the central facet, is then a simple polygon).
+fn check_simple(
+    cx: &Ctx<'_>,
+    vertices: &[InitialVertex],
+    creases: &[InitialCrease],
+    raw: &RawInitial,
+    tol: f64,
+) -> Result<(), TaskError> {
+    let seg = |c: &InitialCrease| (vertices[c.tail].xy, vertices[c.head].xy);
+    for i in 0..creases.len() {
+        for j in 0..i {
+            let (a, b) = (&creases[i], &creases[j]);
+            let shared = [a.tail, a.head]
+                .iter()
+                .filter(|v| **v == b.tail || **v == b.head)
+                .count();
+            if shared > 0 {
+                continue; // same direction at a shared end is ring_at's error
+            }
+            let ((p, q), (r, s)) = (seg(a), seg(b));
+            if segments_meet(p, q, r, s, tol) {
+                return Err(cx.err(
+                    cf(i),
+                    format!(
+                        "crease {} → {} crosses or touches crease {} → {} ({}): G0 is drawn without crossings, so a closed chain of creases must be a simple polygon",
+                        raw.creases[i].from,
+                        raw.creases[i].to,
+                        raw.creases[j].from,
+                        raw.creases[j].to,
+                        cf(j)
+                    ),
+                ));
+            }
+        }
+        // A vertex lying on a crease it is not an end of.
+        for (k, v) in vertices.iter().enumerate() {
+            let c = &creases[i];
+            if k == c.tail || k == c.head {
+                continue;
+            }
+            let (p, q) = seg(c);
+            if point_segment_distance(v.xy, p, q) <= tol {
+                return Err(cx.err(
+                    cf(i),
+                    format!(
+                        "vertex \"{}\" lies on crease {} → {}: a crease runs between its two ends only; split it at the vertex",
+                        v.id, raw.creases[i].from, raw.creases[i].to
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Whether segments pq and rs (no common end) intersect or come within `tol`.
+fn segments_meet(p: [f64; 2], q: [f64; 2], r: [f64; 2], s: [f64; 2], tol: f64) -> bool {
+    let cross = |o: [f64; 2], a: [f64; 2], b: [f64; 2]| {
+        (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    };
+    let (d1, d2) = (cross(p, q, r), cross(p, q, s));
+    let (d3, d4) = (cross(r, s, p), cross(r, s, q));
+    if d1 * d2 < 0.0 && d3 * d4 < 0.0 {
+        return true;
+    }
+    point_segment_distance(r, p, q) <= tol
+        || point_segment_distance(s, p, q) <= tol
+        || point_segment_distance(p, r, s) <= tol
+        || point_segment_distance(q, r, s) <= tol
+}
+
+/// Distance from `x` to the segment pq.
+fn point_segment_distance(x: [f64; 2], p: [f64; 2], q: [f64; 2]) -> f64 {
+    let d = [q[0] - p[0], q[1] - p[1]];
+    let l2 = d[0] * d[0] + d[1] * d[1];
+    let u = if l2 > 0.0 {
+        (((x[0] - p[0]) * d[0] + (x[1] - p[1]) * d[1]) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (x[0] - p[0] - u * d[0]).hypot(x[1] - p[1] - u * d[1])
 }
 
 /// Topology: acyclic, connected, fewer than three successors.

@@ -34,6 +34,7 @@
 //! drive = "t"
 //! ```
 
+mod actuation;
 mod bounds;
 mod check;
 mod constraints;
@@ -53,6 +54,7 @@ pub(crate) mod parse;
 mod robustness;
 mod rotation;
 mod solids;
+pub mod symmetry;
 mod targets;
 pub mod terms;
 pub mod times;
@@ -63,7 +65,8 @@ pub use bounds::Bounds;
 pub use check::{CheckSpec, Cylinder, DEFAULT_OPTIMIZE_STATES};
 pub(crate) use ctx::Ctx;
 pub use drive::Drive;
-pub use initial::{InitialCrease, InitialGraph, InitialVertex, VertexType};
+pub use initial::{G0Actuation, InitialCrease, InitialGraph, InitialVertex, SplitSide, VertexType};
+pub use symmetry::{Group, Isometry, PatternSymmetry};
 pub(crate) use mirror::mirror_map;
 pub use motion::Motion;
 pub use number::Number;
@@ -134,11 +137,14 @@ pub struct Task {
 }
 
 /// Symmetry of a design task.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Symmetry {
     /// Task and G0 are symmetric about the xz-plane (in-plane: the x-axis), so a graph and its
     /// mirror image give the same designs (thesis Sec. 5.5.2).
     pub mirror_xz: bool,
+    /// The pattern's own symmetry (`rotations`, `center`, `mirror_axis`): one orbit
+    /// representative is grown and its images follow (thesis Sec. 4.3).
+    pub pattern: PatternSymmetry,
 }
 
 /// Largest N_max accepted: each extension multiplies the number of graphs by roughly

@@ -46,6 +46,9 @@ struct RawGrammar {
 struct RawSymmetry {
     #[serde(default)]
     mirror_xz: bool,
+    rotations: Option<i64>,
+    center: Option<Vec<super::Number>>,
+    mirror_axis: Option<Vec<Vec<super::Number>>>,
 }
 
 /// A task file read up to G0's crease order.
@@ -83,8 +86,10 @@ impl<'a> Draft<'a> {
                 ),
             ));
         }
+        let pattern = pattern_symmetry(&cx, &raw.symmetry)?;
         let symmetry = Symmetry {
             mirror_xz: raw.symmetry.mirror_xz,
+            pattern,
         };
         let (initial, tol) = initial::build(&cx, &raw.initial_graph)?;
         Ok(Draft {
@@ -97,6 +102,28 @@ impl<'a> Draft<'a> {
             initial,
             tol,
         })
+    }
+
+    /// G0's actuation (which facet stays fixed) and the pattern's symmetry group, once the
+    /// facet labels are known to be consistent.
+    pub(crate) fn actuate(&mut self) -> Result<(), TaskError> {
+        let g = &mut self.initial;
+        g.actuation = super::actuation::actuation(
+            &self.cx,
+            &g.vertices,
+            &g.creases,
+            &g.facets,
+            &self.raw.initial_graph,
+        )?;
+        if self.symmetry.pattern.any() {
+            g.group = Some(super::symmetry::group(
+                &self.cx,
+                g,
+                &self.symmetry.pattern,
+                self.tol,
+            )?);
+        }
+        Ok(())
     }
 
     /// Check the remaining tables and assemble the task; mesh files named by a relative
@@ -181,6 +208,64 @@ fn scene(
         obstacles,
         copies,
         containment,
+    })
+}
+
+/// `[symmetry] rotations`, `center` and `mirror_axis`, read and range-checked.
+fn pattern_symmetry(
+    cx: &Ctx<'_>,
+    raw: &RawSymmetry,
+) -> Result<super::PatternSymmetry, TaskError> {
+    let max = super::symmetry::MAX_ROTATIONS as i64;
+    let rotations = match raw.rotations {
+        None => 1,
+        Some(n) if (2..=max).contains(&n) => n as usize,
+        Some(n) => {
+            return Err(cx.err(
+                "symmetry.rotations",
+                format!(
+                    "{n} is out of range: the order of rotational symmetry is 2..={max} (leave it out for none)"
+                ),
+            ));
+        }
+    };
+    let center = match &raw.center {
+        None => None,
+        Some(_) if rotations == 1 => {
+            return Err(cx.err(
+                "symmetry.center",
+                "a centre needs rotations: give symmetry.rotations (2 or more) or drop the centre",
+            ));
+        }
+        Some(c) => Some(cx.point::<2>("symmetry.center", c)?),
+    };
+    let mirror_axis = match &raw.mirror_axis {
+        None => None,
+        Some(pts) => {
+            if pts.len() != 2 {
+                return Err(cx.err(
+                    "symmetry.mirror_axis",
+                    format!(
+                        "{} points given: the mirror axis is the line through two points, [[x0, y0], [x1, y1]]",
+                        pts.len()
+                    ),
+                ));
+            }
+            let p = cx.point::<2>("symmetry.mirror_axis[0]", &pts[0])?;
+            let q = cx.point::<2>("symmetry.mirror_axis[1]", &pts[1])?;
+            if (q[0] - p[0]).hypot(q[1] - p[1]) <= 1e-9 {
+                return Err(cx.err(
+                    "symmetry.mirror_axis",
+                    "the two points coincide: the axis needs two distinct points",
+                ));
+            }
+            Some([p, q])
+        }
+    };
+    Ok(super::PatternSymmetry {
+        rotations,
+        center,
+        mirror_axis,
     })
 }
 
