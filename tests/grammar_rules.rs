@@ -378,7 +378,10 @@ fn r1_fills_the_missing_slots_in_all_six_scenarios() {
         }
         for (cr, &(slot, reference, sign, n)) in r.created.iter().zip(&sc.placed) {
             assert_eq!(cr.slot, slot);
-            let p = cr.placement.as_ref().expect("a representative's crease is placed");
+            let p = cr
+                .placement
+                .as_ref()
+                .expect("a representative's crease is placed");
             assert_eq!(
                 (name(&g, p.reference), p.sign, p.sectors.len()),
                 (reference, sign, n),

@@ -336,7 +336,8 @@ fn drives_are_checked() {
 #[test]
 fn types_and_structure_of_extendable_vertices_are_checked() {
     // Undriven, v1 → v2 is v1's outgoing crease: an extendable v1 would have no incoming one.
-    let e = err(&edit("type = \"terminal\"", "type = \"extendable\"").replace("drive = \"t\"\n", ""));
+    let e =
+        err(&edit("type = \"terminal\"", "type = \"extendable\"").replace("drive = \"t\"\n", ""));
     assert_err(
         &e,
         "initial_graph.vertices[0].type",
@@ -344,12 +345,21 @@ fn types_and_structure_of_extendable_vertices_are_checked() {
     );
     // Driven, the crease between two extendable vertices enters both ends (Fig. 32's
     // double-sided arrows): G0 holds it as two halves from a source at its midpoint.
-    let t = Task::from_toml_str(&edit("type = \"terminal\"", "type = \"extendable\""), "ok.toml").unwrap();
+    let t = Task::from_toml_str(
+        &edit("type = \"terminal\"", "type = \"extendable\""),
+        "ok.toml",
+    )
+    .unwrap();
     assert_eq!(t.initial.vertices.len(), 3);
     assert_eq!(t.initial.vertices[2].xy, [0.5, 0.0]);
     assert_eq!(t.initial.split.len(), 1);
     for v in 0..2 {
-        assert_eq!(t.initial.vertices[v].preds.len(), 1, "v{} has the drive as its p1", v + 1);
+        assert_eq!(
+            t.initial.vertices[v].preds.len(),
+            1,
+            "v{} has the drive as its p1",
+            v + 1
+        );
     }
     // A lone outgoing crease in the middle of the open sector (no facet shared with p1 or
     // pm) is none of the scenarios of Tables 1–2.

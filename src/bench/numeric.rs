@@ -59,7 +59,7 @@ fn mode_names(modes: &[f64]) -> String {
 /// with the first assignment, in binary order from all up, that gives one. `None` when
 /// none does.
 pub fn rigid_design(model: Model, modes: Option<Vec<f64>>) -> Result<Option<Design>> {
-    let n = model.plan.internal.len();
+    let n = model.plan.n_modes;
     let tries: Vec<Vec<f64>> = match modes {
         Some(m) => vec![m],
         None => (0..1u32 << n).map(|b| modes_of(b, n)).collect(),

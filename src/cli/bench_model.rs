@@ -50,7 +50,7 @@ pub fn run(args: ModelBenchArgs) -> Result<()> {
         bail!("--peer casadi: the CasADi peer covers `bench vertex` only; use --peer symbolica");
     }
     let model = Model::new(&graph, &task, args.candidate - 1)?;
-    let modes = parse_modes(args.modes.as_deref(), model.plan.internal.len())?;
+    let modes = parse_modes(args.modes.as_deref(), model.plan.n_modes)?;
     let b = measure(ModelBenchOptions {
         model: &model,
         modes: &modes,

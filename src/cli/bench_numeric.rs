@@ -50,7 +50,7 @@ fn optimized(task: &Task, args: &NumericBenchArgs) -> Result<Design> {
         bail!("--candidate must be 1, 2 or 3");
     }
     let model = Model::new(&graph, task, args.candidate - 1)?;
-    let n = model.plan.internal.len();
+    let n = model.plan.n_modes;
     let modes = match &args.modes {
         Some(m) => Some(parse_modes(Some(m), n)?),
         None => None,
@@ -118,7 +118,7 @@ fn from_design_file(path: &Path, task_flag: Option<&Path>) -> Result<Design> {
                 path.display()
             )
         })?;
-    let modes = parse_modes(Some(&modes_text.join(",")), model.plan.internal.len())
+    let modes = parse_modes(Some(&modes_text.join(",")), model.plan.n_modes)
         .with_context(|| format!("{}: modes", path.display()))?;
     let free = read_vars(&model, path)?;
     let name = v

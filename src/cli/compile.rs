@@ -67,7 +67,7 @@ pub fn run(args: CompileArgs) -> Result<()> {
         None => aot::c_name(&task.name),
     };
     let model = Model::from_plan(Plan::new(&graph)?, &task, args.candidate - 1)?;
-    let modes = parse_modes(args.modes.as_deref(), model.plan.internal.len())?;
+    let modes = parse_modes(args.modes.as_deref(), model.plan.n_modes)?;
     let opts = Options::default();
     let compiled = CompiledModel::new(&model, &opts)?;
     let iface = interface::interface(&task.name, &model, &compiled, &modes, &name);

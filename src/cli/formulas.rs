@@ -313,7 +313,7 @@ pub fn model_names(model: &Model) -> Names {
             .iter()
             .map(|&i| ascii_name(&model.plan.variables[i].name))
             .collect(),
-        params: (0..model.plan.internal.len())
+        params: (0..model.plan.n_modes)
             .map(|k| format!("M{}", k + 1))
             .chain((0..model.times.len()).map(|k| format!("t{k}")))
             .collect(),
@@ -379,7 +379,7 @@ fn add_gradients(
 
 /// The header's first lines: the model, its variables, parameters and constraints.
 fn model_head(model: &Model, task: &str, names: &Names, n_constraints: usize) -> Vec<String> {
-    let n_modes = model.plan.internal.len();
+    let n_modes = model.plan.n_modes;
     let labels: Vec<String> = (0..n_constraints)
         .map(|k| format!("  g{} = {}", k + 1, model.constraint_label(k)))
         .collect();

@@ -164,7 +164,7 @@ pub fn run(args: ModelArgs) -> Result<()> {
     }
     let plan = Plan::new(&graph)?;
     let model = Model::from_plan(plan, &task, args.candidate - 1)?;
-    let n = model.plan.internal.len();
+    let n = model.plan.n_modes;
     let modes = parse_modes(args.modes.as_deref(), n)?;
     if let Some(fmt) = &args.formulas {
         return print_formulas(&args, fmt, &model, &task.name);
@@ -337,7 +337,7 @@ fn model_json(
     let mut out = json!({
         "task": task.name,
         "graph": model.plan.sequence,
-        "internal_vertices": model.plan.internal.len(),
+        "internal_vertices": model.plan.n_modes,
         "modes": e.modes.iter().map(|m| mode_name(*m)).collect::<Vec<_>>(),
         "candidate": args.candidate,
         "gripping_vertex": model.plan.vertices[model.gripping].name,

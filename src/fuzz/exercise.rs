@@ -48,7 +48,7 @@ pub fn task(text: &str) -> bool {
                 })
                 .collect();
             let full = model.full_vars(&x);
-            let modes = vec![1.0; model.plan.internal.len()];
+            let modes = vec![1.0; model.plan.n_modes];
             let _ = model.omega(&full, &modes);
             let design = Evaluated::new(&model.plan, full, modes);
             let ts = sample_times(model.t_max, 3);

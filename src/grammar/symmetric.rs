@@ -39,7 +39,7 @@ use std::collections::HashSet;
 use super::graph::CreaseGraph;
 use super::rules::RuleError;
 use super::step::Step;
-use super::{Cid, R2Match, Vid, VertexType};
+use super::{Cid, R2Match, VertexType, Vid};
 use crate::task::Group;
 
 /// The orbit structure of a symmetric graph.
@@ -246,11 +246,7 @@ impl CreaseGraph {
     }
 
     /// The error of the first pair of an orbit that does not match, if any.
-    fn orbit_check(
-        &self,
-        pairs: &[(R2Match, usize)],
-        straight: bool,
-    ) -> Result<(), RuleError> {
+    fn orbit_check(&self, pairs: &[(R2Match, usize)], straight: bool) -> Result<(), RuleError> {
         for (p, _) in pairs {
             if straight {
                 self.check_combine_straight(p.c1, p.c2)?;
@@ -358,8 +354,7 @@ impl CreaseGraph {
     /// a pair among them.
     pub(super) fn orbit_pair_matches(&self, straight: bool) -> Vec<(Step, R2Match)> {
         let eligible = |v: &super::Vertex| {
-            v.ty == VertexType::Extendable
-                && (!straight || (v.preds.len() == 1 && !v.in_g0()))
+            v.ty == VertexType::Extendable && (!straight || (v.preds.len() == 1 && !v.in_g0()))
         };
         let chi: Vec<Vid> = self
             .vertices()
@@ -408,7 +403,12 @@ impl CreaseGraph {
                 out.push(((n1.min(n2), n1.max(n2)), step, m));
             }
         }
-        out.sort_by_key(|(k, step, _)| (*k, matches!(step, Step::Combine(a, b) | Step::Straight(a, b) if a > b)));
+        out.sort_by_key(|(k, step, _)| {
+            (
+                *k,
+                matches!(step, Step::Combine(a, b) | Step::Straight(a, b) if a > b),
+            )
+        });
         out.into_iter().map(|(_, s, m)| (s, m)).collect()
     }
 }

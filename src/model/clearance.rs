@@ -240,7 +240,7 @@ fn without(vs: &[usize], skip: usize, r: impl Fn(usize) -> VRef) -> Vec<VRef> {
 fn copy_is(plan: &Plan, map: &CopyMap, k: usize, j: usize) -> Option<usize> {
     let fixed = |v: usize| match plan.vertices[v].position {
         Position::Fixed(p) => Some(p),
-        Position::Placed { .. } | Position::Between { .. } => None,
+        Position::Placed { .. } | Position::Between { .. } | Position::Image { .. } => None,
     };
     let q = fixed(j)?;
     (0..plan.vertices.len()).find(|&i| fixed(i).is_some_and(|p| map.merges(k, q, p)))

@@ -44,7 +44,7 @@ pub fn symbolic(model: &Model) -> (Ctx, Vec<Sym>) {
     let ctx = Ctx::new();
     let free: Vec<Sym> = (0..model.free.len()).map(|k| ctx.var(k)).collect();
     let vars = model.full_vars(&free);
-    let n = model.plan.internal.len();
+    let n = model.plan.n_modes;
     let modes: Vec<Sym> = (0..n).map(|i| ctx.param(i)).collect();
     let times: Vec<Sym> = (0..model.times.len()).map(|i| ctx.param(n + i)).collect();
     let out = model.outputs(&vars, &modes, &times);
@@ -62,9 +62,9 @@ impl CompiledModel {
         let ids: Vec<_> = outputs.iter().map(|s| ctx.node_id(s)).collect();
         let graph = ctx.to_graph();
         let build_ms = start.cpu_ms();
-        let n_params = model.plan.internal.len() + model.times.len();
+        let n_params = model.plan.n_modes + model.times.len();
         let compiled = compile::compile(&graph, &ids, model.free.len(), n_params, opts)?;
-        let n_modes = model.plan.internal.len();
+        let n_modes = model.plan.n_modes;
         let mut modes_used = vec![false; n_modes];
         let reachable = compiled.graph.reachable(&compiled.outputs);
         for (node, _) in compiled
@@ -85,7 +85,7 @@ impl CompiledModel {
             n_vars: model.free.len(),
             n_constraints: ids.len() - 1 - model.surface_aux_len(),
             n_aux: model.surface_aux_len(),
-            n_modes: model.plan.internal.len(),
+            n_modes: model.plan.n_modes,
             compiled,
             build_ms,
             total_ms: start.cpu_ms(),
@@ -185,9 +185,7 @@ impl CompiledMotion {
         let nf = model.free.len();
         let free: Vec<Sym> = (0..nf).map(|k| ctx.param(k)).collect();
         let vars = model.full_vars(&free);
-        let modes: Vec<Sym> = (0..model.plan.internal.len())
-            .map(|i| ctx.param(nf + i))
-            .collect();
+        let modes: Vec<Sym> = (0..model.plan.n_modes).map(|i| ctx.param(nf + i)).collect();
         let flat = geometry::flat(&model.plan, &vars);
         let folded = geometry::fold(&model.plan, &flat, &modes, &t);
         let n_vertices = model.plan.vertices.len();
@@ -196,7 +194,7 @@ impl CompiledMotion {
             .map(|c| ctx.node_id(&c))
             .collect();
         let graph = ctx.to_graph();
-        let n_params = nf + model.plan.internal.len();
+        let n_params = nf + model.plan.n_modes;
         let opts = Options {
             gradients: false,
             ..opts.clone()

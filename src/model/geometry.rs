@@ -46,17 +46,16 @@ fn direction_angle<S: Scalar>(
     from: usize,
     to: usize,
 ) -> S {
-    if let (Position::Placed { parent, crease, .. }, Some(a)) =
-        (&plan.vertices[to].position, &ang[to])
-        && *parent == from
-        && plan.creases[*crease].head == to
+    if let (Some((parent, crease)), Some(a)) = (plan.vertices[to].position.placed_from(), &ang[to])
+        && parent == from
+        && plan.creases[crease].head == to
     {
         return a.clone();
     }
-    if let (Position::Placed { parent, crease, .. }, Some(a)) =
-        (&plan.vertices[from].position, &ang[from])
-        && *parent == to
-        && plan.creases[*crease].head == from
+    if let (Some((parent, crease)), Some(a)) =
+        (plan.vertices[from].position.placed_from(), &ang[from])
+        && parent == to
+        && plan.creases[crease].head == from
     {
         return a.clone() + PI;
     }
@@ -74,13 +73,14 @@ fn direction_angle<S: Scalar>(
 /// lengths) — Eq. 28 and the sectors of Eq. 29, 31, 34, 35.
 pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
     let n = plan.vertices.len();
-    let mut pos: Vec<[S; 2]> = Vec::with_capacity(n);
-    let mut ang: Vec<Option<S>> = Vec::with_capacity(n);
-    for v in &plan.vertices {
+    let zero = || [S::from_f64(0.0), S::from_f64(0.0)];
+    let mut pos: Vec<[S; 2]> = (0..n).map(|_| zero()).collect();
+    let mut ang: Vec<Option<S>> = vec![None; n];
+    for &i in &plan.position_order {
+        let v = &plan.vertices[i];
         match &v.position {
             Position::Fixed(xy) => {
-                pos.push([S::from_f64(xy[0]), S::from_f64(xy[1])]);
-                ang.push(None);
+                pos[i] = [S::from_f64(xy[0]), S::from_f64(xy[1])];
             }
             Position::Placed {
                 parent,
@@ -96,26 +96,35 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
                     .fold(S::from_f64(0.0), |acc, s| acc + vars[*s].clone());
                 let a = base + turn * *sign;
                 let l = vars[*length].clone();
-                let p = [
+                pos[i] = [
                     pos[*parent][0].clone() + l.clone() * a.cos(),
                     pos[*parent][1].clone() + l * a.sin(),
                 ];
-                pos.push(p);
-                ang.push(Some(a));
+                ang[i] = Some(a);
             }
-            // Filled below: an r2′ sink may be named before one of its ends.
-            Position::Between { .. } => {
-                pos.push([S::from_f64(0.0), S::from_f64(0.0)]);
-                ang.push(None);
+            Position::Between { a, b } => {
+                pos[i] = [
+                    (pos[*a][0].clone() + pos[*b][0].clone()) * 0.5,
+                    (pos[*a][1].clone() + pos[*b][1].clone()) * 0.5,
+                ];
             }
-        }
-    }
-    for (i, v) in plan.vertices.iter().enumerate() {
-        if let Position::Between { a, b } = v.position {
-            pos[i] = [
-                (pos[a][0].clone() + pos[b][0].clone()) * 0.5,
-                (pos[a][1].clone() + pos[b][1].clone()) * 0.5,
-            ];
+            Position::Image {
+                source,
+                element,
+                parent,
+            } => {
+                let g = &plan.isometries[*element];
+                let [x, y] = pos[*source].clone();
+                pos[i] = [
+                    x.clone() * g.m[0][0] + y.clone() * g.m[0][1] + g.c[0],
+                    x * g.m[1][0] + y * g.m[1][1] + g.c[1],
+                ];
+                ang[i] = match (parent, &ang[*source]) {
+                    (Some(_), Some(a)) if g.reflects => Some(-a.clone() + g.theta),
+                    (Some(_), Some(a)) => Some(a.clone() + g.theta),
+                    _ => None,
+                };
+            }
         }
     }
     let mut dirs = Vec::with_capacity(n);
@@ -125,14 +134,17 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
             .rays
             .iter()
             .map(|r| {
-                let exact = match (&plan.vertices[r.other].position, &plan.vertices[i].position) {
-                    (Position::Placed { parent, crease, .. }, _)
-                        if r.outgoing && *parent == i && *crease == r.crease =>
+                let exact = match (
+                    plan.vertices[r.other].position.placed_from(),
+                    plan.vertices[i].position.placed_from(),
+                ) {
+                    (Some((parent, crease)), _)
+                        if r.outgoing && parent == i && crease == r.crease =>
                     {
                         ang[r.other].clone()
                     }
-                    (_, Position::Placed { parent, crease, .. })
-                        if !r.outgoing && *parent == r.other && *crease == r.crease =>
+                    (_, Some((parent, crease)))
+                        if !r.outgoing && parent == r.other && crease == r.crease =>
                     {
                         ang[i].clone().map(|a| a + PI)
                     }
@@ -161,7 +173,7 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
                         .fold(S::from_f64(0.0), |acc, (c, x)| acc + vars[*x].clone() * *c),
                 ),
                 Sector::Constant(c) => Some(S::from_f64(*c)),
-                Sector::Remainder => None,
+                Sector::Remainder | Sector::Image { .. } => None,
                 Sector::Geometric => {
                     let (u, w) = (&d[k], &d[(k + 1) % nr]);
                     let cross = u[0].clone() * w[1].clone() - u[1].clone() * w[0].clone();
@@ -177,13 +189,34 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
                 .fold(S::from_f64(0.0), |acc, x| acc + x.clone());
             s[r] = Some(S::from_f64(2.0 * PI) - others);
         }
-        sectors.push(
-            s.into_iter()
-                .map(|x| x.expect("every sector computed"))
-                .collect(),
-        );
+        sectors.push(s);
         dirs.push(d);
     }
+    // An image's sectors are its representative's (computed above: a representative is
+    // never an image).
+    let copies: Vec<Vec<Option<S>>> = plan
+        .vertices
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            v.sectors
+                .iter()
+                .enumerate()
+                .map(|(k, rule)| match rule {
+                    Sector::Image { vertex, k: j } => sectors[*vertex][*j].clone(),
+                    _ => sectors[i][k].clone(),
+                })
+                .collect()
+        })
+        .collect();
+    let sectors = copies
+        .into_iter()
+        .map(|s| {
+            s.into_iter()
+                .map(|x| x.expect("every sector computed"))
+                .collect()
+        })
+        .collect();
     Flat { pos, dirs, sectors }
 }
 
@@ -211,9 +244,10 @@ pub fn units<S: Scalar>(
     ])
 }
 
-/// The folded state at `t` with rigid body modes `modes` (±1 per internal vertex, in the
-/// order of [`Plan::internal`]).
+/// The folded state at `t` with rigid body modes `modes` (±1 per mode parameter,
+/// [`Plan::n_modes`]; every internal vertex folds by [`Plan::vertex_modes`]).
 pub fn fold<S: Scalar>(plan: &Plan, flat: &Flat<S>, modes: &[S], t: &S) -> Folded<S> {
+    let modes = plan.vertex_modes(modes);
     let mut rho: Vec<Option<S>> = plan
         .creases
         .iter()
@@ -239,18 +273,42 @@ pub fn fold<S: Scalar>(plan: &Plan, flat: &Flat<S>, modes: &[S], t: &S) -> Folde
     let nf = plan.facets;
     let mut rot: Vec<Mat3<S>> = vec![linalg::identity(); nf];
     let mut trans: Vec<Vec3<S>> = vec![[zero(), zero(), zero()]; nf];
-    let act = &plan.creases[plan.actuation.crease];
-    let tail = &flat.pos[act.tail];
-    let head = &flat.pos[act.head];
-    let (dx, dy) = (
-        head[0].clone() - tail[0].clone(),
-        head[1].clone() - tail[1].clone(),
-    );
-    let len = (dx.clone() * dx.clone() + dy.clone() * dy.clone()).sqrt();
-    let (dx, dy) = (dx / len.clone(), dy / len);
-    let half = rho[plan.actuation.crease].clone() * 0.5;
-    let x_tail: Vec3<S> = [tail[0].clone(), tail[1].clone(), zero()];
-    for (f, angle) in [(act.left, half.clone()), (act.right, -half)] {
+    let about = |c: usize| {
+        let cr = &plan.creases[c];
+        let (tail, head) = (&flat.pos[cr.tail], &flat.pos[cr.head]);
+        let (dx, dy) = (
+            head[0].clone() - tail[0].clone(),
+            head[1].clone() - tail[1].clone(),
+        );
+        let len = (dx.clone() * dx.clone() + dy.clone() * dy.clone()).sqrt();
+        let x_tail: Vec3<S> = [tail[0].clone(), tail[1].clone(), zero()];
+        (dx / len.clone(), dy / len, x_tail)
+    };
+    let turns: Vec<(usize, usize, S)> = match plan.actuation.fixed {
+        // One facet stays (identity); crossing a driven crease from the facet right of it
+        // to the left turns by +ρ (SPEC §3), the other way by −ρ.
+        Some(fixed) => plan
+            .actuation
+            .driven
+            .iter()
+            .map(|&c| {
+                let cr = &plan.creases[c];
+                if cr.right == fixed {
+                    (c, cr.left, rho[c].clone())
+                } else {
+                    (c, cr.right, -rho[c].clone())
+                }
+            })
+            .collect(),
+        None => {
+            let c = plan.actuation.crease;
+            let act = &plan.creases[c];
+            let half = rho[c].clone() * 0.5;
+            vec![(c, act.left, half.clone()), (c, act.right, -half)]
+        }
+    };
+    for (c, f, angle) in turns {
+        let (dx, dy, x_tail) = about(c);
         let r = linalg::rot_in_plane_axis(&dx, &dy, &angle);
         trans[f] = linalg::sub(&x_tail, &linalg::apply(&r, &x_tail));
         rot[f] = r;

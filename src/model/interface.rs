@@ -34,16 +34,30 @@ pub fn interface(
             }
         })
         .collect();
-    let mut params: Vec<Parameter> = model
-        .plan
-        .internal
-        .iter()
+    let plan = &model.plan;
+    let mut params: Vec<Parameter> = (0..plan.n_modes)
         .zip(modes)
-        .enumerate()
-        .map(|(k, (&v, &mode))| Parameter {
-            name: format!("M{}", k + 1),
-            doc: format!("mode of v{} (+1 up, -1 down)", model.plan.vertices[v].name),
-            default: mode,
+        .map(|(k, &mode)| {
+            // The internal vertices that fold by this parameter (an orbit's members).
+            let who: Vec<String> = plan
+                .internal
+                .iter()
+                .zip(&plan.modes)
+                .filter(|(_, (slot, _))| *slot == k)
+                .map(|(&v, (_, sign))| {
+                    let name = plan.vertices[v].name;
+                    if *sign < 0.0 {
+                        format!("-v{name}")
+                    } else {
+                        format!("v{name}")
+                    }
+                })
+                .collect();
+            Parameter {
+                name: format!("M{}", k + 1),
+                doc: format!("mode of {} (+1 up, -1 down)", who.join(", ")),
+                default: mode,
+            }
         })
         .collect();
     params.extend(model.times.iter().enumerate().map(|(k, &t)| Parameter {
@@ -134,7 +148,7 @@ fn constants(model: &Model, m: usize, n: usize, n_out: usize) -> Vec<Constant> {
         c("n_constraints", m, "constraints g_k >= 0"),
         c(
             "n_modes",
-            model.plan.internal.len(),
+            model.plan.n_modes,
             "mode parameters: params[0 .. N_MODES)",
         ),
         c(

@@ -183,11 +183,9 @@ impl Model {
         let ctx = crate::expr::Ctx::new();
         let all: Vec<usize> = (0..self.plan.variables.len()).collect();
         let vars: Vec<crate::expr::Sym> = all.iter().map(|&i| ctx.var(i)).collect();
-        let modes: Vec<crate::expr::Sym> = (0..self.plan.internal.len())
-            .map(|i| ctx.param(i))
-            .collect();
+        let modes: Vec<crate::expr::Sym> = (0..self.plan.n_modes).map(|i| ctx.param(i)).collect();
         let times: Vec<crate::expr::Sym> = (0..self.times.len())
-            .map(|i| ctx.param(self.plan.internal.len() + i))
+            .map(|i| ctx.param(self.plan.n_modes + i))
             .collect();
         let out = self.outputs(&vars, &modes, &times);
         let mut ids = vec![ctx.node_id(&out.objective)];

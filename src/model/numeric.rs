@@ -58,10 +58,11 @@ impl<'a> Evaluated<'a> {
             // for a gripper design). Re-solve every vertex on the zeroed driving angles
             // and take the flat state's φ = 0.
             let rho: Vec<Option<f64>> = folded.rho.iter().map(|r| Some(*r)).collect();
+            let modes = self.plan.vertex_modes(&self.modes);
             for (k, &a) in self.plan.internal.iter().enumerate() {
                 let units = geometry::units(self.plan, &self.flat, &rho, a)
                     .expect("every fold angle is set");
-                let mut st = solve_vertex(&units, &self.modes[k]);
+                let mut st = solve_vertex(&units, &modes[k]);
                 st.phi = [0.0; 3];
                 folded.states[a] = Some(st);
             }

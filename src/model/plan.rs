@@ -38,6 +38,30 @@ pub enum Position {
         /// The other end (the predecessor of c2).
         b: usize,
     },
+    /// The image of vertex `source` under the pattern's symmetry `element`
+    /// ([`Plan::isometries`]): `x = g(x_source)`.
+    Image {
+        /// The orbit's representative.
+        source: usize,
+        /// Index into [`Plan::isometries`].
+        element: usize,
+        /// The image of the source's placing crease, when it is this vertex's (its
+        /// direction is the image of the source's exact placement angle): its tail and
+        /// the crease.
+        parent: Option<(usize, usize)>,
+    },
+}
+
+impl Position {
+    /// The vertex and crease that place this vertex along an exact angle (r1's placement
+    /// or its image).
+    pub fn placed_from(&self) -> Option<(usize, usize)> {
+        match self {
+            Position::Placed { parent, crease, .. } => Some((*parent, *crease)),
+            Position::Image { parent, .. } => *parent,
+            _ => None,
+        }
+    }
 }
 
 /// One crease leaving a vertex, seen from that vertex.
@@ -63,6 +87,13 @@ pub enum Sector {
     /// From the in-plane coordinates: the counter-clockwise angle between the rays,
     /// `atan2(u × v, u · v)`, valid while the sector lies in (0, π) (Eq. 34–35).
     Geometric,
+    /// Equal to sector `k` of vertex `vertex`, whose image this vertex is.
+    Image {
+        /// The orbit's representative.
+        vertex: usize,
+        /// Its sector.
+        k: usize,
+    },
 }
 
 /// A vertex of the plan.
@@ -183,12 +214,18 @@ impl fmt::Display for PlanError {
 
 impl std::error::Error for PlanError {}
 
-/// The actuation of the initial graph: one driven crease, folded mirror-symmetrically
-/// (SPEC §4: the facet left of it turns by +ρ/2 about it, the facet right of it by −ρ/2).
+/// The actuation of the initial graph: one driven line folded mirror-symmetrically (SPEC
+/// §4: the facet left of it turns by +ρ/2 about it, the facet right of it by −ρ/2), or a
+/// fixed facet whose driven neighbours turn about their creases (a driven central facet,
+/// thesis Sec. 3.4, 4.3).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Actuation {
-    /// The driven crease.
+    /// A driven crease (the first): for the symmetric fold, the line it turns about.
     pub crease: usize,
+    /// The facet that stays fixed, if any (else the fold about `crease` is symmetric).
+    pub fixed: Option<usize>,
+    /// Every driven crease.
+    pub driven: Vec<usize>,
 }
 
 /// Everything about one graph that the model needs, with dense indices.
@@ -223,7 +260,27 @@ pub struct Plan {
     pub candidates: Option<[usize; 3]>,
     /// The cycles r2′ closed (empty for the thesis's acyclic grammar).
     pub sinks: Vec<Sink>,
+    /// The pattern's symmetries (the identity first; only it without a symmetry).
+    pub isometries: Vec<crate::task::Isometry>,
+    /// For every vertex: its orbit's representative and the element taking it there.
+    pub orbit: Vec<(usize, usize)>,
+    /// The order in which vertex positions are computed (an image after its source, a
+    /// placed vertex after its parent and reference).
+    pub position_order: Vec<usize>,
+    /// For every internal vertex (as in [`Plan::internal`]): the mode parameter it folds
+    /// by and its sign (an image under a reflection folds by the opposite sign of the
+    /// mirrored vertex triangle).
+    pub modes: Vec<(usize, f64)>,
+    /// Number of mode parameters: one per extended orbit (per internal vertex without a
+    /// symmetry, or with [`Plan::with_vertex_modes`]).
+    pub n_modes: usize,
 }
+
+/// The mode sign of a vertex mirrored by a reflection relative to its source: the
+/// reflection reverses the counter-clockwise order of its creases (u2 and u3 trade
+/// places), which mirrors the vertex triangle, and the same folded shape is the other
+/// solution of the PTU.
+pub const MIRROR_MODE_SIGN: f64 = -1.0;
 
 impl Plan {
     /// Build the plan of `graph`.
@@ -239,6 +296,34 @@ impl Plan {
     /// Sectors of vertex `v` that bound a facet (all of them for internal vertices).
     pub fn sector_count(&self, v: usize) -> usize {
         self.vertices[v].sectors.len()
+    }
+
+    /// The mode of every internal vertex (in the order of [`Plan::internal`]) from the
+    /// mode parameters.
+    pub fn vertex_modes<S: crate::kinematics::Scalar>(&self, modes: &[S]) -> Vec<S> {
+        self.modes
+            .iter()
+            .map(|&(k, sign)| {
+                if sign == 1.0 {
+                    modes[k].clone()
+                } else {
+                    modes[k].clone() * sign
+                }
+            })
+            .collect()
+    }
+
+    /// The same plan with one mode parameter per internal vertex (images no longer fold
+    /// like their representative: the star pattern's 2^8 assignments, Sec. 4.3.2).
+    pub fn with_vertex_modes(mut self) -> Plan {
+        self.modes = (0..self.internal.len()).map(|k| (k, 1.0)).collect();
+        self.n_modes = self.internal.len();
+        self
+    }
+
+    /// Whether the pattern has a symmetry.
+    pub fn is_symmetric(&self) -> bool {
+        self.isometries.len() > 1
     }
 }
 
@@ -282,7 +367,7 @@ impl Builder {
         let (creases, actuation) = self.creases(graph)?;
         let mut vertices = Vec::new();
         for v in graph.vertices() {
-            let position = self.position(graph, v)?;
+            let position = self.position(graph, v, &creases)?;
             self.v(v.vid)?;
             let rays = self.rays(v, &creases)?;
             vertices.push(Vertex {
@@ -298,6 +383,12 @@ impl Builder {
             let sectors = sector_rules(&vertices, &creases, i)?;
             vertices[i].sectors = sectors;
         }
+        for i in 0..vertices.len() {
+            if let Some(image) = self.image_sectors(graph, &vertices, i)? {
+                vertices[i].sectors = image;
+            }
+        }
+        let position_order = position_order(&vertices)?;
         let facets = graph.facet_count();
         let polygons = facet_polygons(&creases, facets)?;
         let internal: Vec<usize> = graph
@@ -329,6 +420,19 @@ impl Builder {
             Some(c) => Some([self.v(c[0])?, self.v(c[1])?, self.v(c[2])?]),
             None => None,
         };
+        let isometries = graph.group().map_or_else(
+            || vec![crate::task::Isometry::identity()],
+            |g| g.elements.clone(),
+        );
+        let orbit = graph
+            .vertex_ids()
+            .iter()
+            .map(|&v| {
+                let (r, g) = graph.orbit_source(v);
+                Ok((self.v(r)?, g))
+            })
+            .collect::<Result<Vec<_>, PlanError>>()?;
+        let (modes, n_modes) = self.modes(graph)?;
         Ok(Plan {
             sequence: graph.sequence(),
             vertices,
@@ -350,7 +454,83 @@ impl Builder {
             constraints,
             candidates,
             sinks,
+            isometries,
+            orbit,
+            position_order,
+            modes,
+            n_modes,
         })
+    }
+
+    /// Every internal vertex's mode parameter and sign.
+    fn modes(&self, graph: &CreaseGraph) -> Result<(Vec<(usize, f64)>, usize), PlanError> {
+        let mut out = Vec::new();
+        let mut n = 0;
+        for &v in graph.extension_order() {
+            let (slot, g) = graph.mode_slot(v).ok_or_else(|| {
+                PlanError(format!(
+                    "the extended vertex {v:?} has no mode of its orbit"
+                ))
+            })?;
+            let reflects = graph.group().is_some_and(|gr| gr.reflects(g));
+            out.push((slot, if reflects { MIRROR_MODE_SIGN } else { 1.0 }));
+            n = n.max(slot + 1);
+        }
+        Ok((out, n))
+    }
+
+    /// For an image vertex, each sector as the representative's sector it is the image
+    /// of (a reflection reverses the order of the rays); `None` for other vertices.
+    fn image_sectors(
+        &self,
+        graph: &CreaseGraph,
+        vertices: &[Vertex],
+        i: usize,
+    ) -> Result<Option<Vec<Sector>>, PlanError> {
+        let Position::Image {
+            source, element, ..
+        } = vertices[i].position
+        else {
+            return Ok(None);
+        };
+        let ids = graph.vertex_ids();
+        let (vi, vj) = (&vertices[i], &vertices[source]);
+        if vi.rays.len() != vj.rays.len() || vi.sectors.len() != vj.sectors.len() {
+            return Ok(None);
+        }
+        let n = vi.rays.len();
+        let mut map = Vec::with_capacity(n);
+        for r in &vi.rays {
+            let k = vj
+                .rays
+                .iter()
+                .position(|q| graph.image_of(ids[q.other], element) == ids[r.other])
+                .ok_or_else(|| {
+                    PlanError(format!(
+                        "v{} is not the image of v{}: a crease has no counterpart",
+                        vi.name, vj.name
+                    ))
+                })?;
+            map.push(k);
+        }
+        let reflects = graph.group().is_some_and(|g| g.reflects(element));
+        let mut out = Vec::with_capacity(vi.sectors.len());
+        for k in 0..vi.sectors.len() {
+            let (a, b) = (map[k], map[(k + 1) % n]);
+            let src = if reflects { b } else { a };
+            let next = if reflects { a } else { b };
+            if (src + 1) % n != next || src >= vj.sectors.len() {
+                return Err(PlanError(format!(
+                    "v{}'s sector {k} has no counterpart at v{}",
+                    vi.name, vj.name
+                )));
+            }
+            out.push(Sector::Image {
+                vertex: source,
+                k: src,
+            });
+        }
+        Ok(Some(out))
     }
 
     /// The creases with dense indices, and the one driven crease.
@@ -382,14 +562,43 @@ impl Builder {
                 length,
             });
         }
-        let actuation = match driven.as_slice() {
-            [one] => Actuation { crease: *one },
-            [] => return Err(PlanError("the initial graph has no driven crease".into())),
-            _ => {
+        let Some(&first) = driven.first() else {
+            return Err(PlanError("the initial graph has no driven crease".into()));
+        };
+        let fixed = match graph.initial_graph().actuation {
+            crate::task::G0Actuation::Split { .. } => None,
+            crate::task::G0Actuation::Fixed { .. } => {
+                // The facet every driven crease bounds (facet ids may have moved since G0).
+                let c = &creases[first];
+                [c.left, c.right]
+                    .into_iter()
+                    .find(|f| {
+                        driven
+                            .iter()
+                            .all(|&i| creases[i].left == *f || creases[i].right == *f)
+                    })
+                    .map(Some)
+                    .ok_or_else(|| {
+                        PlanError("the driven creases no longer bound one facet".into())
+                    })?
+            }
+        };
+        if fixed.is_none() && driven.len() > 1 {
+            let c = &creases[first];
+            if driven
+                .iter()
+                .any(|&i| (creases[i].left, creases[i].right) != (c.left, c.right))
+            {
                 return Err(PlanError(
-                    "only one driven crease (folded mirror-symmetrically) is supported".into(),
+                    "driven creases folded symmetrically must lie between the same two facets"
+                        .into(),
                 ));
             }
+        }
+        let actuation = Actuation {
+            crease: first,
+            fixed,
+            driven,
         };
         Ok((creases, actuation))
     }
@@ -399,6 +608,7 @@ impl Builder {
         &self,
         graph: &CreaseGraph,
         v: &crate::grammar::Vertex,
+        creases: &[Crease],
     ) -> Result<Position, PlanError> {
         Ok(match (&v.placement, v.g0_coords) {
             (Some(p), _) => {
@@ -421,6 +631,30 @@ impl Builder {
                 Position::Between {
                     a: self.v(a)?,
                     b: self.v(b)?,
+                }
+            }
+            (None, None) if graph.orbit_source(v.vid).0 != v.vid => {
+                let (src, g) = graph.orbit_source(v.vid);
+                let source = self.v(src)?;
+                let me = self.v(v.vid)?;
+                let sv = graph
+                    .vertex(src)
+                    .ok_or_else(|| PlanError(format!("vertex {src:?} is not in the graph")))?;
+                // The image of the source's placing crease, if it ends here.
+                let parent = match &sv.placement {
+                    Some(p) => {
+                        let tail = self.v(graph.image_of(p.parent, g))?;
+                        creases
+                            .iter()
+                            .position(|c| c.tail == tail && c.head == me)
+                            .map(|c| (tail, c))
+                    }
+                    None => None,
+                };
+                Position::Image {
+                    source,
+                    element: g,
+                    parent,
                 }
             }
             (None, None) => {
@@ -546,9 +780,10 @@ fn facet_walk(
     facets: usize,
 ) -> Result<(Vec<WalkStep>, Vec<bool>), PlanError> {
     let mut known = vec![false; facets];
-    let act = &creases[actuation.crease];
-    known[act.left] = true;
-    known[act.right] = true;
+    for &c in &actuation.driven {
+        known[creases[c].left] = true;
+        known[creases[c].right] = true;
+    }
     let mut walk = Vec::new();
     for &a in internal {
         let v = &vertices[a];
@@ -624,6 +859,58 @@ fn sinks(vertices: &[Vertex], creases: &[Crease]) -> Result<Vec<Sink>, PlanError
         }
     }
     Ok(sinks)
+}
+
+/// An order of the vertices in which every position is computed after those it is
+/// computed from.
+fn position_order(vertices: &[Vertex]) -> Result<Vec<usize>, PlanError> {
+    let deps = |v: &Vertex| -> Vec<usize> {
+        match &v.position {
+            Position::Fixed(_) => Vec::new(),
+            Position::Placed {
+                parent, reference, ..
+            } => vec![*parent, *reference],
+            Position::Between { a, b } => vec![*a, *b],
+            Position::Image { source, .. } => vec![*source],
+        }
+    };
+    let n = vertices.len();
+    let mut state = vec![0u8; n]; // 0 new, 1 on the stack, 2 done
+    let mut order = Vec::with_capacity(n);
+    for root in 0..n {
+        let mut stack = vec![(root, false)];
+        while let Some((v, expanded)) = stack.pop() {
+            if expanded {
+                state[v] = 2;
+                order.push(v);
+                continue;
+            }
+            match state[v] {
+                2 => continue,
+                1 => {
+                    return Err(PlanError(format!(
+                        "the position of v{} depends on itself",
+                        vertices[v].name
+                    )));
+                }
+                _ => {}
+            }
+            state[v] = 1;
+            stack.push((v, true));
+            for d in deps(&vertices[v]) {
+                if state[d] == 1 {
+                    return Err(PlanError(format!(
+                        "the position of v{} depends on itself",
+                        vertices[v].name
+                    )));
+                }
+                if state[d] == 0 {
+                    stack.push((d, false));
+                }
+            }
+        }
+    }
+    Ok(order)
 }
 
 /// A sector that is exactly one variable (its bounds are the variable's box).

@@ -287,7 +287,10 @@ pub struct RobustModel {
     /// In-plane positions of the flat layout and their Jacobian (issue 20).
     flat_fn: Compiled,
     n_vertices: usize,
+    /// Internal vertices (three margins each).
     n_internal: usize,
+    /// Mode parameters (before t in the compiled functions' parameters).
+    n_modes: usize,
     t_max: f64,
     /// Milliseconds from the start of the build to native code.
     pub total_ms: f64,
@@ -315,6 +318,7 @@ impl RobustModel {
                 *l = Some(l.map_or(thick, |m| m.min(thick)));
             }
         }
+        let nm = plan.n_modes;
         let (nv, ni, nf, nc) = (
             plan.vertices.len(),
             plan.internal.len(),
@@ -324,8 +328,8 @@ impl RobustModel {
         let ctx = Ctx::new();
         let free: Vec<Sym> = (0..nf).map(|k| ctx.var(k)).collect();
         let vars = model.full_vars(&free);
-        let modes: Vec<Sym> = (0..ni).map(|i| ctx.param(i)).collect();
-        let t = ctx.param(ni);
+        let modes: Vec<Sym> = (0..nm).map(|i| ctx.param(i)).collect();
+        let t = ctx.param(nm);
         let flat = geometry::flat(plan, &vars);
         let flat_ids: Vec<_> = flat.pos.iter().flatten().map(|s| ctx.node_id(s)).collect();
         let folded = geometry::fold(plan, &flat, &modes, &t);
@@ -351,8 +355,8 @@ impl RobustModel {
         value_ids.extend(m.iter().chain(&rho).map(|s| ctx.node_id(s)));
         let graph = ctx.to_graph();
         let base = Options::default();
-        let taped = compile::tape::taped(&graph, &value_ids, nf, ni + 1, base.simplify.as_ref())?;
-        let flat_fn = compile::compile(&graph, &flat_ids, nf, ni + 1, &base)?;
+        let taped = compile::tape::taped(&graph, &value_ids, nf, nm + 1, base.simplify.as_ref())?;
+        let flat_fn = compile::compile(&graph, &flat_ids, nf, nm + 1, &base)?;
         Ok(RobustModel {
             pairs,
             creases,
@@ -365,6 +369,7 @@ impl RobustModel {
             flat_fn,
             n_vertices: nv,
             n_internal: ni,
+            n_modes: nm,
             t_max: model.t_max,
             total_ms: start.elapsed().as_secs_f64() * 1e3,
         })
@@ -488,7 +493,7 @@ impl RobustModel {
     /// Buffers sized for this block.
     pub fn work(&self) -> Work {
         Work {
-            params: vec![0.0; self.n_internal + 1 + self.n_weights() + self.taped.n_tape],
+            params: vec![0.0; self.n_modes + 1 + self.n_weights() + self.taped.n_tape],
             out: vec![0.0; self.taped.n_values + self.taped.n_tape],
             grad: vec![0.0; self.taped.reverse.n_outputs()],
             weights: vec![0.0; self.n_weights()],
@@ -501,16 +506,17 @@ impl RobustModel {
 
     /// Evaluate the values at `t` (compiled) into `work.values`.
     pub fn eval(&self, free: &[f64], modes: &[f64], t: f64, work: &mut Work) {
+        let nm = self.n_modes;
         let ni = self.n_internal;
-        work.params[..ni].copy_from_slice(modes);
-        work.params[ni] = t;
+        work.params[..nm].copy_from_slice(modes);
+        work.params[nm] = t;
         self.taped
             .forward
-            .call(free, &work.params[..ni + 1], &mut work.out)
+            .call(free, &work.params[..nm + 1], &mut work.out)
             .expect("buffer sizes match the compiled layout");
         work.tape_at.clear();
         work.tape_at.extend_from_slice(free);
-        work.tape_at.extend_from_slice(&work.params[..ni + 1]);
+        work.tape_at.extend_from_slice(&work.params[..nm + 1]);
         let nv = self.n_vertices;
         work.x.clear();
         work.x
@@ -559,19 +565,19 @@ impl RobustModel {
         work: &mut Work,
         grad: &mut [f64],
     ) {
-        let ni = self.n_internal;
+        let nm = self.n_modes;
         // The tape is the last `eval`'s: evaluate first unless it was at this point.
         let (nf, at) = (free.len(), &work.tape_at);
-        let same = at.len() == nf + ni + 1
+        let same = at.len() == nf + nm + 1
             && at[..nf] == *free
-            && at[nf..nf + ni] == *modes
-            && at[nf + ni] == t;
+            && at[nf..nf + nm] == *modes
+            && at[nf + nm] == t;
         if !same {
             self.eval(free, modes, t, work);
         }
         let (nv, nt) = (self.taped.n_values, self.taped.n_tape);
-        work.params[ni + 1..ni + 1 + nv].copy_from_slice(weights);
-        work.params[ni + 1 + nv..].copy_from_slice(&work.out[nv..nv + nt]);
+        work.params[nm + 1..nm + 1 + nv].copy_from_slice(weights);
+        work.params[nm + 1 + nv..].copy_from_slice(&work.out[nv..nv + nt]);
         self.taped
             .reverse
             .call(free, &work.params, &mut work.grad)
@@ -842,11 +848,7 @@ impl RobustModel {
         let n = self.n_vertices;
         self.flat_fn
             .function
-            .call(
-                free,
-                &work.params[..self.n_internal + 1],
-                &mut work.flat_out,
-            )
+            .call(free, &work.params[..self.n_modes + 1], &mut work.flat_out)
             .expect("buffer sizes match the compiled layout");
         work.flat.clear();
         work.flat

@@ -66,13 +66,13 @@ pub use check::{CheckSpec, Cylinder, DEFAULT_OPTIMIZE_STATES};
 pub(crate) use ctx::Ctx;
 pub use drive::Drive;
 pub use initial::{G0Actuation, InitialCrease, InitialGraph, InitialVertex, SplitSide, VertexType};
-pub use symmetry::{Group, Isometry, PatternSymmetry};
 pub(crate) use mirror::mirror_map;
 pub use motion::Motion;
 pub use number::Number;
 pub use robustness::{
     DEFAULT_CLEARANCE, DEFAULT_MIN_FEATURE, DEFAULT_RIGID_MARGIN, MAX_RIGID_MARGIN, Robustness,
 };
+pub use symmetry::{Group, Isometry, PatternSymmetry};
 pub use terms::{Objective, Target};
 
 /// A task file that failed to load: the file, the field (a TOML path such as

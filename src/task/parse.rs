@@ -212,10 +212,7 @@ fn scene(
 }
 
 /// `[symmetry] rotations`, `center` and `mirror_axis`, read and range-checked.
-fn pattern_symmetry(
-    cx: &Ctx<'_>,
-    raw: &RawSymmetry,
-) -> Result<super::PatternSymmetry, TaskError> {
+fn pattern_symmetry(cx: &Ctx<'_>, raw: &RawSymmetry) -> Result<super::PatternSymmetry, TaskError> {
     let max = super::symmetry::MAX_ROTATIONS as i64;
     let rotations = match raw.rotations {
         None => 1,

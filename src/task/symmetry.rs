@@ -211,8 +211,8 @@ pub(crate) fn group(
     if let Some([p, q]) = sym.mirror_axis {
         if sym.rotations > 1 {
             let d = [q[0] - p[0], q[1] - p[1]];
-            let off = ((center[0] - p[0]) * d[1] - (center[1] - p[1]) * d[0]).abs()
-                / d[0].hypot(d[1]);
+            let off =
+                ((center[0] - p[0]) * d[1] - (center[1] - p[1]) * d[0]).abs() / d[0].hypot(d[1]);
             if off > tol {
                 return Err(cx.err(
                     "symmetry.mirror_axis",
