@@ -29,7 +29,7 @@ pub struct CreaseGraph {
     pub(super) steps: Vec<StepRecord>,
     pub(super) extension_order: Vec<Vid>,
     /// Orbits under the pattern's symmetry group (`None` without one).
-    pub(super) sym: Option<super::symmetric::SymState>,
+    pub(super) sym: Option<super::orbits::SymState>,
 }
 
 /// One ray of the rotation around a vertex.
@@ -120,10 +120,7 @@ impl CreaseGraph {
             );
             edge_of.push(e);
         }
-        let sym = init
-            .group
-            .as_ref()
-            .map(super::symmetric::SymState::of_initial);
+        let sym = init.group.as_ref().map(super::orbits::SymState::of_initial);
         CreaseGraph {
             order: (0..init.vertices.len()).map(|i| Vid(i as u32)).collect(),
             facet_names: init.facets.clone(),

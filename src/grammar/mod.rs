@@ -83,6 +83,7 @@ mod canon;
 mod enumerate;
 mod graph;
 mod notation;
+mod orbits;
 mod rules;
 mod step;
 mod straight;

@@ -69,9 +69,9 @@ fn direction_angle<S: Scalar>(
     dy.atan2(&dx)
 }
 
-/// The pattern in the plane for the given variable values (sector angles in radians,
-/// lengths) — Eq. 28 and the sectors of Eq. 29, 31, 34, 35.
-pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
+/// Every vertex's in-plane position and, where r1 placed it (or its image), the exact
+/// angle of its placing crease (Eq. 28).
+fn positions<S: Scalar>(plan: &Plan, vars: &[S]) -> (Vec<[S; 2]>, Vec<Option<S>>) {
     let n = plan.vertices.len();
     let zero = || [S::from_f64(0.0), S::from_f64(0.0)];
     let mut pos: Vec<[S; 2]> = (0..n).map(|_| zero()).collect();
@@ -127,6 +127,14 @@ pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
             }
         }
     }
+    (pos, ang)
+}
+
+/// The pattern in the plane for the given variable values (sector angles in radians,
+/// lengths) — Eq. 28 and the sectors of Eq. 29, 31, 34, 35.
+pub fn flat<S: Scalar>(plan: &Plan, vars: &[S]) -> Flat<S> {
+    let n = plan.vertices.len();
+    let (pos, ang) = positions(plan, vars);
     let mut dirs = Vec::with_capacity(n);
     let mut sectors = Vec::with_capacity(n);
     for (i, v) in plan.vertices.iter().enumerate() {

@@ -75,7 +75,7 @@ pub struct InitialGraph {
     pub actuation: G0Actuation,
     /// The pattern's symmetry group (`[symmetry] rotations`, `mirror_axis`): the grammar
     /// grows one orbit representative and its images follow; `None` without one.
-    pub group: Option<super::symmetry::Group>,
+    pub group: Option<super::isometry::Group>,
 }
 
 /// A driven crease between two extendable vertices, incoming at both ends: G0 holds it as
@@ -203,7 +203,7 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial) -> Result<(InitialGraph, f64
     let (mut creases, facets) = creases(cx, raw, &index)?;
     check_drives(cx, &vertices, &creases, raw)?;
     check_simple(cx, &vertices, &creases, raw, tol)?;
-    let split = super::actuation::split_sides(&mut vertices, &mut creases, raw);
+    let split = split_sides(&mut vertices, &mut creases, raw);
     check_topology(cx, &vertices, &creases)?;
 
     // The counter-clockwise order around every vertex.
@@ -211,7 +211,7 @@ pub(crate) fn build(cx: &Ctx<'_>, raw: &RawInitial) -> Result<(InitialGraph, f64
         let ring = ring_at(cx, &vertices, &creases, vi)?;
         order_vertex(cx, &mut vertices, &creases, &facets, vi, ring)?;
     }
-    super::actuation::check_corners(cx, &vertices, &creases)?;
+    check_corners(cx, &vertices, &creases)?;
     // Filled in by `Draft::actuate`, after the facet labels are checked.
     let actuation = G0Actuation::Split { crease: 0 };
     let g = InitialGraph {
@@ -563,6 +563,91 @@ fn check_topology(
                 vf(i),
                 format!("vertex \"{}\" already has {out} outgoing creases: G0 vertices must have fewer than 3 (thesis Sec. 5.2)", v.id),
             ));
+        }
+    }
+    Ok(())
+}
+
+/// Split every driven crease between two extendable vertices at its midpoint: the crease
+/// becomes the half mid → `to` in place, the half mid → `from` is appended, and the
+/// midpoint (terminal, named `mid(from,to)`) is appended to the vertices.
+pub(crate) fn split_sides(
+    vertices: &mut Vec<InitialVertex>,
+    creases: &mut Vec<InitialCrease>,
+    raw: &RawInitial,
+) -> Vec<SplitSide> {
+    let mut split = Vec::new();
+    for i in 0..creases.len() {
+        let c = creases[i].clone();
+        let two_sided = c.drive.is_some()
+            && vertices[c.tail].ty == VertexType::Extendable
+            && vertices[c.head].ty == VertexType::Extendable;
+        if !two_sided {
+            continue;
+        }
+        let (a, b) = (vertices[c.tail].xy, vertices[c.head].xy);
+        let mid = vertices.len();
+        vertices.push(InitialVertex {
+            id: format!("mid({},{})", raw.creases[i].from, raw.creases[i].to),
+            xy: [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])],
+            ty: VertexType::Terminal,
+            preds: Vec::new(),
+            slots: [None; 3],
+            ring: Vec::new(),
+        });
+        // mid → to keeps the crease's sides; mid → from runs the other way, so they swap.
+        creases[i].tail = mid;
+        let back = creases.len();
+        creases.push(InitialCrease {
+            tail: mid,
+            head: c.tail,
+            left: c.right,
+            right: c.left,
+            drive: c.drive.clone(),
+        });
+        split.push(SplitSide {
+            file_index: i,
+            ends: [c.tail, c.head],
+            mid,
+            halves: [i, back],
+        });
+    }
+    split
+}
+
+/// Every closed sector between two incoming creases of an extendable G0 vertex (a corner
+/// of a driven polygon, say) is a sector of its PTU, so it must lie in (0, π): a polygon
+/// driven from its sides must be convex.
+pub(crate) fn check_corners(
+    cx: &Ctx<'_>,
+    vertices: &[InitialVertex],
+    creases: &[InitialCrease],
+) -> Result<(), TaskError> {
+    for (i, v) in vertices.iter().enumerate() {
+        if v.ty != VertexType::Extendable {
+            continue;
+        }
+        for w in v.preds.windows(2) {
+            let dir = |c: usize| {
+                let o = vertices[creases[c].tail].xy;
+                (o[1] - v.xy[1]).atan2(o[0] - v.xy[0])
+            };
+            let mut a = dir(w[1]) - dir(w[0]);
+            if a <= 0.0 {
+                a += std::f64::consts::TAU;
+            }
+            if a >= std::f64::consts::PI - 1e-9 {
+                return Err(cx.err(
+                    format!("initial_graph.vertices[{i}]"),
+                    format!(
+                        "the sector of \"{}\" between its incoming creases from \"{}\" and \"{}\" is {:.1}°: a vertex's sectors lie below 180° (the PTU's units are Euler triangles' sides), so a polygon driven from its sides must be convex at every corner",
+                        v.id,
+                        vertices[creases[w[0]].tail].id,
+                        vertices[creases[w[1]].tail].id,
+                        a.to_degrees()
+                    ),
+                ));
+            }
         }
     }
     Ok(())

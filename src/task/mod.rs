@@ -43,6 +43,7 @@ mod drive;
 mod fab_table;
 pub mod fabrication;
 mod initial;
+pub mod isometry;
 mod meshes;
 mod mirror;
 mod motion;
@@ -54,7 +55,7 @@ pub(crate) mod parse;
 mod robustness;
 mod rotation;
 mod solids;
-pub mod symmetry;
+mod symmetry;
 mod targets;
 pub mod terms;
 pub mod times;
@@ -66,13 +67,13 @@ pub use check::{CheckSpec, Cylinder, DEFAULT_OPTIMIZE_STATES};
 pub(crate) use ctx::Ctx;
 pub use drive::Drive;
 pub use initial::{G0Actuation, InitialCrease, InitialGraph, InitialVertex, SplitSide, VertexType};
+pub use isometry::{Group, Isometry, PatternSymmetry};
 pub(crate) use mirror::mirror_map;
 pub use motion::Motion;
 pub use number::Number;
 pub use robustness::{
     DEFAULT_CLEARANCE, DEFAULT_MIN_FEATURE, DEFAULT_RIGID_MARGIN, MAX_RIGID_MARGIN, Robustness,
 };
-pub use symmetry::{Group, Isometry, PatternSymmetry};
 pub use terms::{Objective, Target};
 
 /// A task file that failed to load: the file, the field (a TOML path such as

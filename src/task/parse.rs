@@ -213,7 +213,7 @@ fn scene(
 
 /// `[symmetry] rotations`, `center` and `mirror_axis`, read and range-checked.
 fn pattern_symmetry(cx: &Ctx<'_>, raw: &RawSymmetry) -> Result<super::PatternSymmetry, TaskError> {
-    let max = super::symmetry::MAX_ROTATIONS as i64;
+    let max = super::isometry::MAX_ROTATIONS as i64;
     let rotations = match raw.rotations {
         None => 1,
         Some(n) if (2..=max).contains(&n) => n as usize,
