@@ -4,7 +4,8 @@
 //! its own PTU. Facts checked: the folded pattern is the representative's turned by the
 //! symmetry at every t (its images' positions and fold angles are the rotations of its
 //! own, computed independently), every facet map is a rigid motion that keeps shared
-//! vertices together (closure), and the compiled model matches the f64 kinematics.
+//! vertices together (closure). (The compiled model against these f64 kinematics is not
+//! tested here yet.)
 
 #![allow(clippy::needless_range_loop)] // coordinates by index read as the formulas
 
