@@ -2,7 +2,7 @@
 //! orbit representative and its rotations follow, r2 joins a vertex with one of the
 //! neighbouring sector's, and the model folds every corner (two driven creases each) by
 //! its own PTU. Facts checked: the folded pattern is the representative's turned by the
-//! symmetry at every t (its images' positions and fold angles are the rotations of its
+//! symmetry at every t (its images' folded positions are the rotations of its
 //! own, computed independently), every facet map is a rigid motion that keeps shared
 //! vertices together (closure). (The compiled model against these f64 kinematics is not
 //! tested here yet.)
