@@ -134,27 +134,24 @@ impl Group {
     /// The G0 vertex standing for the orbit of G0 vertex `v`: the first of its images in
     /// file order, and the element taking that representative to `v`.
     pub fn g0_source(&self, v: usize) -> (usize, usize) {
-        let rep = (0..self.order())
-            .map(|g| self.vertex[g][v])
-            .min()
-            .expect("the identity");
-        let g = (0..self.order())
-            .find(|&g| self.vertex[g][rep] == v)
-            .expect("v is in rep's orbit");
-        (rep, g)
+        orbit_source(&self.vertex, v)
     }
 
     /// As [`Group::g0_source`] for a G0 crease.
     pub fn g0_crease_source(&self, c: usize) -> (usize, usize) {
-        let rep = (0..self.order())
-            .map(|g| self.crease[g][c])
-            .min()
-            .expect("the identity");
-        let g = (0..self.order())
-            .find(|&g| self.crease[g][rep] == c)
-            .expect("c is in rep's orbit");
-        (rep, g)
+        orbit_source(&self.crease, c)
     }
+}
+
+/// The least image of `x` under the permutations `perm` (one per element, the identity
+/// among them) and the element taking it to `x`.
+fn orbit_source(perm: &[Vec<usize>], x: usize) -> (usize, usize) {
+    let rep = perm.iter().map(|p| p[x]).min().expect("the identity");
+    let g = perm
+        .iter()
+        .position(|p| p[rep] == x)
+        .expect("x is in rep's orbit");
+    (rep, g)
 }
 
 /// The symmetry as the task file gives it.
