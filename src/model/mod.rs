@@ -79,6 +79,11 @@ pub struct Model {
     pub area: Option<crate::task::terms::AreaTerm>,
     /// The task's copies (the flat area counts each; the packing footprint covers all).
     pub copies: crate::scene::Copies,
+    /// The containment boxes that apply at one state (`[[constraints.inside]]` with a `t`):
+    /// every vertex of every copy inside, as smooth constraints of the model itself, so the
+    /// optimum an area term drives outwards already lies in the box (the robustness block
+    /// then only adds the wall gap; from outside it rarely got back in).
+    pub boxes: Vec<crate::scene::Containment>,
     /// Success threshold on Ω.
     pub threshold: f64,
     /// Which of the three successors of the vertex extended last grips (0, 1, 2).
@@ -160,6 +165,10 @@ impl Model {
             orientations: resolved.orientations,
             area: objective.area,
             copies: task.scene.copies,
+            boxes: (task.scene.containment.iter())
+                .filter(|b| b.t.is_some())
+                .cloned()
+                .collect(),
             threshold: objective.threshold,
             candidate,
             gripping,

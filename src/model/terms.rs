@@ -3,7 +3,8 @@
 //! written over [`Scalar`], so the compiled model and the f64 path are the same code.
 //!
 //! Output order (after the thesis's constraints, the cyclic ones and Kawasaki's):
-//! orientation constraints (per requirement, per state, per non-vacuous side), then with
+//! orientation constraints (per requirement, per state, per non-vacuous side), the
+//! one-state containment boxes (per box, copy, vertex, axis: the two walls), then with
 //! an area term `threshold − Ω ≥ 0` (when there are targets) and `A − at_least ≥ 0`; the
 //! auxiliary outputs (3 per surface target: its vertex's position) come after every
 //! constraint, so the constraints' Jacobian stays one block.
@@ -116,6 +117,7 @@ pub(super) fn extra_times(model: &Model) -> Vec<f64> {
     if let Some(AreaKind::Packing { t }) = model.area.map(|a| a.kind) {
         out.push(t);
     }
+    out.extend(model.boxes.iter().filter_map(|b| b.t));
     out
 }
 
@@ -205,6 +207,7 @@ pub(super) fn constraints<S: Scalar>(
             }
         }
     }
+    containment(model, flat, folded, &mut out);
     if let Some(term) = model.area {
         if !model.targets.is_empty() {
             out.push(S::from_f64(model.threshold) - omega.clone());
@@ -213,6 +216,45 @@ pub(super) fn constraints<S: Scalar>(
         out.push(a - term.at_least);
     }
     out
+}
+
+/// Every vertex of every copy inside each of [`Model::boxes`] at its state: per box, copy,
+/// vertex and box axis `i`, `half_i ∓ a_i·(x − c) ≥ 0`, with the copy's rotation folded
+/// into constant coefficients (the constraint is linear in the vertex's position).
+fn containment<S: Scalar>(model: &Model, flat: &Flat<S>, folded: &[Folded<S>], out: &mut Vec<S>) {
+    use crate::geom::{dot, sub};
+    let n = model.copies.n.max(1);
+    for b in &model.boxes {
+        let f = &folded[time_index(model, b.t.expect("model boxes have a state"))];
+        let x: Vec<Vec3<S>> = (0..model.plan.vertices.len())
+            .map(|v| geometry::position(&model.plan, flat, f, v))
+            .collect();
+        let bx = &b.bounds;
+        for copy in 0..n {
+            // a_i·(R (x − P) + P − c) = Σ_j (a_i R)_j x_j + a_i·(g(0) − c), g(0) = P − R P.
+            let r = model.copies.rotation(copy);
+            let moved_origin = model.copies.apply(copy, [0.0; 3]);
+            let rows: Vec<([f64; 3], f64)> = (0..3)
+                .map(|i| {
+                    let a = bx.axes[i];
+                    let ar = [0, 1, 2].map(|j| (0..3).map(|k| a[k] * r[k][j]).sum::<f64>());
+                    (ar, dot(a, sub(moved_origin, bx.center)))
+                })
+                .collect();
+            for xv in &x {
+                for (i, (ar, o)) in rows.iter().enumerate() {
+                    let q = (0..3).fold(S::from_f64(*o), |acc, j| acc + xv[j].clone() * ar[j]);
+                    out.push(S::from_f64(bx.half[i]) - q.clone());
+                    out.push(q + bx.half[i]);
+                }
+            }
+        }
+    }
+}
+
+/// The number of constraints [`containment`] writes.
+fn containment_count(model: &Model) -> usize {
+    model.boxes.len() * model.copies.n.max(1) * model.plan.vertices.len() * 6
 }
 
 /// The number of constraints [`constraints`] writes.
@@ -226,7 +268,7 @@ pub(super) fn count(model: &Model) -> usize {
         None => 0,
         Some(_) => 1 + usize::from(!model.targets.is_empty()),
     };
-    orient + area
+    orient + containment_count(model) + area
 }
 
 /// The index, among [`constraints`], of `threshold − Ω ≥ 0` (an area term beside targets).
@@ -257,6 +299,24 @@ pub(super) fn label(model: &Model, j: usize) -> String {
             );
         }
         k -= n;
+    }
+    let per_box = containment_count(model) / model.boxes.len().max(1);
+    if k < containment_count(model) {
+        let (b, rest) = (&model.boxes[k / per_box], k % per_box);
+        let nv = model.plan.vertices.len();
+        let (copy, vertex, wall) = (rest / (6 * nv), (rest / 6) % nv, rest % 6);
+        return format!(
+            "inside '{}' at t = {}: v{} (copy {copy}) {} {}-wall",
+            b.name,
+            b.t.unwrap_or(model.t_max),
+            model.plan.vertices[vertex].name,
+            if wall % 2 == 0 {
+                "below the +"
+            } else {
+                "above the −"
+            },
+            ["x", "y", "z"][wall / 2]
+        );
     }
     if Some(j) == omega_constraint(model) {
         return format!("objective: Ω (smoothed) ≤ threshold {}", model.threshold);

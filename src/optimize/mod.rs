@@ -150,7 +150,8 @@ pub struct Options {
     /// robotic arm 110 designs at 100, 109 at 60 (its time is phase A).
     pub robust_inner: u64,
     /// Phase B is tried on at most this many starts per problem (later starts still run
-    /// phase A and count when the block accepts them as they are).
+    /// phase A and count when the block accepts them as they are); with
+    /// [`Options::all_starts`] on every start.
     pub robust_starts: usize,
     /// Give up on a problem with a positive target after this many starts (0: never) when
     /// none of them found a feasible point with `f ≤ give_up_factor · target`: the rest of
@@ -830,7 +831,15 @@ impl<P: Problem> Lagrangian<'_, P> {
             Acceptance::Refined
         };
         let mut ok = first == Acceptance::Accepted;
-        if first == Acceptance::Refined && *attempts < opts.robust_starts {
+        // With `all_starts` every start is a candidate optimum of its own (an area has no
+        // natural zero), so each gets its phase B: the Sec. 3.4 flasher's only designs
+        // inside the cuboid at N = 2 came from its 5th to 16th starts.
+        let limit = if opts.all_starts {
+            usize::MAX
+        } else {
+            opts.robust_starts
+        };
+        if first == Acceptance::Refined && *attempts < limit {
             *attempts += 1;
             // Phase B: the block's constraints join, warm-started from phase A's optimum
             // with its multipliers; μ restarts low so the new terms are not ill-conditioned.

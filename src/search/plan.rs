@@ -85,6 +85,10 @@ pub struct Plan {
     pub generated: usize,
     /// Meaningful graphs that are cyclic patterns (r2′).
     pub cyclic_graphs: usize,
+    /// Gripping candidates per graph: 3 (s1, s2, s3 of the vertex extended last), or 1 when
+    /// no term of the task names a gripping vertex (an area or a box alone), since the
+    /// three would be the same problem ([`Task::uses_gripping_vertex`]).
+    pub candidates: usize,
     /// Seconds the enumeration took (wall).
     pub enumerate_s: f64,
     /// (hash of the sequence, graph index), sorted: finds a graph by its sequence without
@@ -156,11 +160,12 @@ impl Plan {
                 });
             }
         });
-        let mut units = Vec::with_capacity(graphs.len() * 3);
+        let candidates = if task.uses_gripping_vertex() { 3 } else { 1 };
+        let mut units = Vec::with_capacity(graphs.len() * candidates);
         let mut first = 0u64;
         for (g, pg) in graphs.iter().enumerate() {
             let count = 1u64 << pg.n;
-            for candidate in 0..3 {
+            for candidate in 0..candidates {
                 units.push(Unit {
                     graph: g,
                     candidate,
@@ -180,6 +185,7 @@ impl Plan {
         Plan {
             n_max,
             cyclic_graphs,
+            candidates,
             graphs,
             units,
             alternatives: first,
@@ -222,7 +228,7 @@ impl Plan {
             .map(|&(_, i)| i)
             .find(|&i| self.graphs[i].sequence == sequence)?;
         let candidate: usize = candidate.parse().ok()?;
-        if !(1..=3).contains(&candidate) {
+        if !(1..=self.candidates).contains(&candidate) {
             return None;
         }
         let names: Vec<&str> = modes.split(',').collect();
@@ -237,7 +243,7 @@ impl Plan {
                 _ => return None,
             }
         }
-        let unit = g * 3 + candidate - 1;
+        let unit = g * self.candidates + candidate - 1;
         Some(Place {
             unit,
             modes: bits,

@@ -137,6 +137,31 @@ pub struct Task {
     pub fabrication: Option<fabrication::Fabrication>,
 }
 
+impl Task {
+    /// Whether some term names a vertex relative to the gripping vertex (`tip`, `s1`–`s3`,
+    /// `last`: a target, an orientation or a fold limit). When none does, the three
+    /// gripping candidates of a graph are one and the same problem, and the search
+    /// optimizes one.
+    pub fn uses_gripping_vertex(&self) -> bool {
+        let relative = |v: &terms::VertexRef| !matches!(v, terms::VertexRef::Initial { .. });
+        let targets = self.objective.iter().flat_map(|o| &o.targets);
+        targets.map(|t| &t.vertex).any(relative)
+            || self
+                .requirements
+                .orientations
+                .iter()
+                .any(|o| relative(&o.vertex))
+            || self
+                .requirements
+                .fold_limits
+                .iter()
+                .any(|l| match &l.crease {
+                    terms::CreaseRef::Into(v) => relative(v),
+                    terms::CreaseRef::Initial { .. } => false,
+                })
+    }
+}
+
 /// Symmetry of a design task.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Symmetry {
