@@ -4,8 +4,8 @@
 //! its own PTU. Facts checked: the folded pattern is the representative's turned by the
 //! symmetry at every t (its images' folded positions are the rotations of its
 //! own, computed independently), every facet map is a rigid motion that keeps shared
-//! vertices together (closure). (The compiled model against these f64 kinematics is not
-//! tested here yet.)
+//! vertices together (closure); the compiled model equals these f64 kinematics (≤ 1e-12)
+//! and its gradients agree with central differences.
 
 #![allow(clippy::needless_range_loop)] // coordinates by index read as the formulas
 
@@ -156,6 +156,231 @@ fn side_vertex_joins_two_sectors() {
         assert_ne!(
             plan.orbit[tails[0]].1, plan.orbit[tails[1]].1,
             "from two sectors"
+        );
+    }
+}
+
+/// Every vertex triangle of the model's states away from its kinks (margins and the
+/// perimeter deficit 2π − ΣU at least 1e-2), where central differences mean something.
+fn smooth(model: &foldsynth::model::Model, x: &[f64], modes: &[f64]) -> bool {
+    let flat = geometry::flat(&model.plan, &model.full_vars(x));
+    model.times.iter().all(|t| {
+        let folded = geometry::fold(&model.plan, &flat, modes, t);
+        folded.states.iter().flatten().all(|st| {
+            let deficit = 2.0 * std::f64::consts::PI - st.u.iter().sum::<f64>();
+            st.margins.iter().all(|m| m.abs() >= 1e-2) && deficit >= 1e-2
+        })
+    })
+}
+
+#[test]
+fn corners_with_two_driven_creases_compile_to_the_f64_kinematics_and_their_gradients() {
+    use foldsynth::compile::Options;
+    use foldsynth::model::Model;
+    use foldsynth::model::compiled::{CompiledModel, ModelProblem, outputs_f64};
+    use foldsynth::optimize::{self, Evaluation, Problem};
+    let task = Task::load(FLASHER).unwrap();
+    let (mut compared, mut differentiated) = (0, 0);
+    for seq in ["1", "1, 9", "1, (9, 20)", "1, 11, (9, 32)"] {
+        let graph = CreaseGraph::from_sequence(&task, seq).unwrap();
+        let model = Model::new(&graph, &task, 0).unwrap();
+        let compiled = CompiledModel::new(&model, &Options::default()).unwrap();
+        let mut buf = vec![0.0; compiled.buffer_len()];
+        for bits in 0..(1u32 << model.plan.n_modes) {
+            let modes: Vec<f64> = (0..model.plan.n_modes)
+                .map(|i| if bits >> i & 1 == 1 { -1.0 } else { 1.0 })
+                .collect();
+            let problem = ModelProblem::new(&model, &compiled, &modes);
+            let mut e = Evaluation::new(problem.n_vars(), problem.n_constraints());
+            let points = optimize::quasi_random_points(model.free.len(), 60, 5 + bits as u64);
+            for u in &points {
+                let x: Vec<f64> = u
+                    .iter()
+                    .zip(&model.free)
+                    .map(|(u, &i)| {
+                        let (lo, hi) = model.var_bounds(i);
+                        lo + (hi - lo) * u
+                    })
+                    .collect();
+                // The compiled model is the f64 kinematics, every output (≤ 1e-12 relative).
+                compiled.call(&x, &compiled.params(&model, &modes), &mut buf);
+                let (f, g) = outputs_f64(&model, &x, &modes);
+                let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1.0);
+                assert!(close(buf[0], f), "{seq}: objective {} vs {f}", buf[0]);
+                for (k, gk) in g.iter().enumerate() {
+                    assert!(
+                        close(buf[k + 1], *gk) || (gk.is_nan() && buf[k + 1].is_nan()),
+                        "{seq}: {}: {} vs {gk}",
+                        model.constraint_label(k),
+                        buf[k + 1]
+                    );
+                }
+                compared += 1;
+                problem.eval(&x, &mut e);
+                if e.g.iter().any(|g| g.abs() < 1e-2) || !smooth(&model, &x, &modes) {
+                    continue;
+                }
+                differentiated += 1;
+                let h = 1e-6;
+                for j in 0..x.len() {
+                    let (mut xp, mut xm) = (x.clone(), x.clone());
+                    xp[j] += h;
+                    xm[j] -= h;
+                    let (fp, gp) = outputs_f64(&model, &xp, &modes);
+                    let (fm, gm) = outputs_f64(&model, &xm, &modes);
+                    let fd = (fp - fm) / (2.0 * h);
+                    assert!(
+                        (fd - e.df[j]).abs() <= 1e-5 * (1.0 + fd.abs()),
+                        "{seq} ∂f/∂x{j}: {fd} vs {}",
+                        e.df[j]
+                    );
+                    for k in 0..gp.len() {
+                        let fd = (gp[k] - gm[k]) / (2.0 * h);
+                        let an = e.dg[k * x.len() + j];
+                        assert!(
+                            (fd - an).abs() <= 1e-5 * (1.0 + fd.abs()),
+                            "{seq} ∂g{k}/∂x{j}: {fd} vs {an}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(compared >= 400, "{compared} points compared");
+    assert!(
+        differentiated >= 20,
+        "only {differentiated} smooth points differentiated"
+    );
+}
+
+/// The rigid flasher of Fig. 32c in the thesis's own construction (Sec. 4.3.1): every
+/// corner of the central facet extended by three creases, two of them from neighbouring
+/// corners joined at one side vertex on each side (v1 of Fig. 32), then v1 and the
+/// diagonal's end v2 extended with their rotations, whose new creases meet in the second
+/// layer's vertices, each joined to one side vertex and one diagonal end (the adapted
+/// flasher's v4 and v5, Sec. 3.5.3).
+const RIGID_FLASHER: &str = "1, (9, 20), 9, 10, (17, 40), (19, 29)";
+
+#[test]
+fn the_rigid_flasher_is_a_meaningful_graph_of_the_cuboid_task() {
+    use foldsynth::grammar::{Enumeration, Filters};
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/flasher_cuboid.toml");
+    let task = Task::load(file).unwrap();
+    let e = Enumeration::run(&task, 3, Filters::all());
+    let node = e
+        .meaningful()
+        .find(|n| n.graph.sequence() == RIGID_FLASHER)
+        .expect("the rigid flasher is enumerated");
+    let plan = Plan::new(&node.graph).unwrap();
+    // Three extended orbits of four: corners, side vertices, diagonal ends.
+    assert_eq!(plan.internal.len(), 12);
+    let corners: Vec<usize> = (0..4).collect();
+    for &c in &corners {
+        // Degree 5: two driven creases of the central facet, three from the grammar.
+        assert_eq!(plan.vertices[c].rays.len(), 5, "corner v{}", c + 1);
+    }
+    let sector_of = |v: usize| plan.orbit[v].1;
+    let pred_sets: Vec<Vec<usize>> = (0..plan.vertices.len())
+        .filter(|&v| plan.vertices[v].preds == 2)
+        .map(|v| plan.vertices[v].rays[..2].iter().map(|r| r.other).collect())
+        .collect();
+    // Side vertices: two corners of the central facet from neighbouring sectors.
+    let sides: Vec<&Vec<usize>> = pred_sets
+        .iter()
+        .filter(|p| p.iter().all(|v| corners.contains(v)))
+        .collect();
+    assert_eq!(sides.len(), 4, "one side vertex per side");
+    for p in &sides {
+        assert_ne!(sector_of(p[0]), sector_of(p[1]));
+    }
+    let side_vertices: Vec<usize> = (0..plan.vertices.len())
+        .filter(|&v| {
+            plan.vertices[v].preds == 2
+                && plan.vertices[v].rays[..2]
+                    .iter()
+                    .all(|r| corners.contains(&r.other))
+        })
+        .collect();
+    // Second layer: 8 vertices, each joined to one side vertex and one diagonal end (a
+    // corner's successor that is not a side vertex).
+    let layer2: Vec<&Vec<usize>> = pred_sets
+        .iter()
+        .filter(|p| p.iter().any(|v| side_vertices.contains(v)))
+        .collect();
+    assert_eq!(layer2.len(), 8, "{pred_sets:?}");
+    for p in &layer2 {
+        let diagonal_end = p.iter().find(|v| !side_vertices.contains(v)).unwrap();
+        let from = plan.vertices[*diagonal_end].rays[0].other;
+        assert!(
+            corners.contains(&from),
+            "v{} grows from a corner",
+            diagonal_end + 1
+        );
+    }
+}
+
+#[test]
+fn one_mode_per_vertex_folds_each_image_by_its_own_choice() {
+    let task = Task::load(FLASHER).unwrap();
+    let graph = CreaseGraph::from_sequence(&task, "1, 9").unwrap();
+    let plan = Plan::new(&graph).unwrap().with_vertex_modes();
+    assert_eq!(
+        plan.n_modes, 8,
+        "four corners and four vertices of the first layer"
+    );
+    // The design `foldsynth synthesize grammar/flasher_cuboid.toml --n-max 2` found for
+    // this graph (flat area 54.8), rigid over its motion.
+    let design = [
+        ("l_1,9", 2.0),
+        ("l_1,10", 2.0),
+        ("l_1,11", 0.1),
+        ("l_9,21", 2.0),
+        ("l_9,22", 2.0),
+        ("l_9,23", 2.0),
+        ("α_9", 1.5757459817734865),
+        ("α_10", 1.4621383502335963),
+        ("α_11", 0.1745329251994492),
+        ("α_21", 2.0177084022658),
+        ("α_22", 1.1011805368487178),
+        ("α_23", 2.040536276595077),
+    ];
+    let vars: Vec<f64> = plan
+        .variables
+        .iter()
+        .map(|v| design.iter().find(|d| d.0 == v.name).unwrap().1)
+        .collect();
+    let flat = geometry::flat(&plan, &vars);
+    let t = 0.6;
+    let up = geometry::fold(&plan, &flat, &[1.0; 8], &t);
+    assert!(
+        up.states
+            .iter()
+            .flatten()
+            .all(|s| s.margins.iter().all(|m| *m > 0.0))
+    );
+    let pos = |f: &geometry::Folded<f64>, v: usize| geometry::position(&plan, &flat, f, v);
+    for k in 0..8 {
+        let mut modes = vec![1.0; 8];
+        modes[k] = -1.0;
+        let one = geometry::fold(&plan, &flat, &modes, &t);
+        let v = plan.internal[k];
+        // The vertex itself stays where its predecessors put it; at least one successor
+        // moves (the other PTU solution), and a vertex of another sector that does not
+        // descend from it stays.
+        let moved: Vec<usize> = (0..plan.vertices.len())
+            .filter(|&w| {
+                let (a, b) = (pos(&up, w), pos(&one, w));
+                (0..3).any(|i| (a[i] - b[i]).abs() > 1e-6)
+            })
+            .collect();
+        assert!(!moved.is_empty(), "flipping v{} moves nothing", v + 1);
+        assert!(!moved.contains(&v), "v{} moved by its own mode", v + 1);
+        assert!(
+            moved.len() < plan.vertices.len() / 2,
+            "flipping v{} moved {} of {} vertices",
+            v + 1,
+            moved.len(),
+            plan.vertices.len()
         );
     }
 }

@@ -1,6 +1,6 @@
 //! `foldsynth model TASK --graph SEQ [--modes …] [--candidate K] [--at VARS.json]
-//! [--formulas FORMAT [--no-simplify] [--gradient] [--output FILE]] [--json]`: the
-//! optimization model of one graph, compiled, evaluated and verified.
+//! [--formulas FORMAT [--no-simplify] [--gradient] [--output FILE]] [--vertex-modes]
+//! [--json]`: the optimization model of one graph, compiled, evaluated and verified.
 
 use crate::check::verify::{Tolerances, VerifyReport, verify};
 use crate::compile::Options;
@@ -70,6 +70,12 @@ pub struct ModelArgs {
     /// `foldsynth simulate` read it.
     #[arg(long, value_name = "DESIGN.json")]
     pub save: Option<PathBuf>,
+    /// Judge every assignment of one rigid body mode per internal vertex at this point
+    /// (images of a symmetric pattern included: the star pattern's 2^8, thesis Sec. 4.3.2):
+    /// rigid over the sweep, free of self-intersection, clear of the obstacles; print the
+    /// counts (and with --json every assignment's verdict).
+    #[arg(long)]
+    pub vertex_modes: bool,
 }
 
 /// Parse "up,down,…" into ±1 for `n` internal vertices.
@@ -177,6 +183,9 @@ pub fn run(args: ModelArgs) -> Result<()> {
     if args.optimize {
         x = optimize(&args, &model, &compiled, &modes);
     }
+    if args.vertex_modes {
+        return print_vertex_modes(&args, &task, &model, &x);
+    }
     let e = Evaluation::new(&model, &compiled, x, modes, args.sweep);
     if let Some(path) = &args.save {
         save_design(path, &task, &model, &e)?;
@@ -189,6 +198,39 @@ pub fn run(args: ModelArgs) -> Result<()> {
     print_model(&args, &task, &model, &compiled, &e);
     if let Some(path) = &args.save {
         println!("\ndesign written to {}", path.display());
+    }
+    Ok(())
+}
+
+/// `--vertex-modes`: the census of every per-vertex mode assignment at `x`.
+fn print_vertex_modes(args: &ModelArgs, task: &Task, model: &Model, x: &[f64]) -> Result<()> {
+    let all = crate::search::modes::census(task, model, x, args.sweep)
+        .map_err(|e| anyhow::anyhow!("--vertex-modes: {e}"))?;
+    let rigid = all.iter().filter(|v| v.rigid_over_motion).count();
+    let folds = all.iter().filter(|v| v.folds()).count();
+    if args.json {
+        let out = json!({
+            "sequence": model.plan.sequence,
+            "internal_vertices": model.plan.internal.iter().map(|&v| format!("v{}", model.plan.vertices[v].name)).collect::<Vec<_>>(),
+            "assignments": all.len(),
+            "rigid_over_motion": rigid,
+            "fold": folds,
+            "verdicts": all,
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+        return Ok(());
+    }
+    println!(
+        "{} mode assignments of {} ({} internal vertices, one mode each), {} states over [0, t_max]:",
+        all.len(),
+        model.plan.sequence,
+        model.plan.internal.len(),
+        args.sweep
+    );
+    println!("  rigid over the whole motion                  {rigid}");
+    println!("  … also free of self-intersection and obstacles {folds}");
+    for v in all.iter().filter(|v| v.folds()) {
+        println!("    {}", v.modes.join(","));
     }
     Ok(())
 }
@@ -214,6 +256,8 @@ fn optimize(args: &ModelArgs, model: &Model, compiled: &CompiledModel, modes: &[
         starts: args.starts,
         seed: args.seed,
         target: Some(objective_target(model)),
+        // An area objective has no target to stop at: every start runs, as in a search.
+        all_starts: crate::model::compiled::all_starts(model),
         max_outer: if model.plan.sinks.is_empty() {
             crate::optimize::Options::default().max_outer
         } else {

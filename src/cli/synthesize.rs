@@ -21,7 +21,8 @@ pub struct SynthesizeArgs {
     /// Worker threads, 0 (one per core) to 256.
     #[arg(long, default_value_t = 0, value_parser = limits::count::<0, { limits::JOBS_MAX as u64 }>)]
     pub jobs: usize,
-    /// Starting points per design alternative, 1 to 1000.
+    /// Starting points per design alternative, 1 to 1000 (an area objective runs three
+    /// times as many: it has no target to stop at).
     #[arg(long, default_value_t = SearchOptions::default().starts, value_parser = limits::count::<1, { limits::STARTS_MAX as u64 }>)]
     pub starts: usize,
     /// Seed of the starting points (same seed, same results).

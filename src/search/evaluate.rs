@@ -54,7 +54,7 @@ pub fn prepare(
 }
 
 /// Why an intersection check could not run.
-enum CheckFailure {
+pub(super) enum CheckFailure {
     /// The flat layout is invalid (counts as a self-intersection).
     Layout(String),
     /// Anything else (reported).
@@ -106,7 +106,7 @@ fn optimize_alternative(
     let model = &p.model;
     let problem = ModelProblem::new(model, &p.compiled, modes);
     let optimize_opts = optimize::Options {
-        starts: opts.starts,
+        starts: crate::model::compiled::search_starts(model, opts.starts),
         seed: shared.seed(),
         target: Some(objective_target(model)),
         all_starts: crate::model::compiled::all_starts(model),
@@ -303,7 +303,7 @@ fn judge(
 
 /// The self-intersection check over the sweep's frames of `arm` (with its rotated copy
 /// for a two-armed task) and the first obstacle hit; with the pattern checked.
-fn check_intersections(
+pub(super) fn check_intersections(
     task: &Task,
     arm: &Pattern,
     opts: &SearchOptions,

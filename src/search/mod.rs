@@ -29,6 +29,7 @@ mod finish;
 pub mod guide;
 pub mod lock;
 mod measure;
+pub mod modes;
 mod open;
 mod options;
 pub mod output;
