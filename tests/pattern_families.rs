@@ -384,3 +384,60 @@ fn one_mode_per_vertex_folds_each_image_by_its_own_choice() {
         );
     }
 }
+
+/// The flasher test task with every `(from, to)` edit applied (each must occur), loaded.
+fn flasher_edited(edits: &[(&str, &str)]) -> foldsynth::task::TaskError {
+    let mut text = std::fs::read_to_string(FLASHER).unwrap();
+    for (from, to) in edits {
+        assert!(text.contains(from), "{from}");
+        text = text.replacen(from, to, 1);
+    }
+    match Task::from_toml_str(&text, "bad.toml") {
+        Ok(_) => panic!("accepted with {edits:?}"),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn driven_polygons_that_cannot_work_are_refused_naming_the_field() {
+    let refused = |e: foldsynth::task::TaskError, field: &str, words: &str| {
+        assert_eq!(e.file, "bad.toml");
+        assert_eq!(e.field, field, "{e}");
+        assert!(e.message.contains(words), "`{words}` not in: {e}");
+        assert!(
+            e.to_string().starts_with(&format!("bad.toml: {field}: ")),
+            "{e}"
+        );
+    };
+    // Not simple: b and c swapped, the chain a → b → c → d is a bow tie.
+    refused(
+        flasher_edited(&[
+            ("xy = [-1.0, 1.0]", "xy = [-1.0, -9.0]"),
+            ("xy = [-1.0, -1.0]", "xy = [-1.0, 1.0]"),
+            ("xy = [-1.0, -9.0]", "xy = [-1.0, -1.0]"),
+        ]),
+        "initial_graph.creases[2]",
+        "must be a simple polygon",
+    );
+    // Not convex: corner b pushed onto the diagonal, its two driven creases no longer
+    // spanning a sector below 180° (no Euler triangle).
+    refused(
+        flasher_edited(&[("xy = [-1.0, 1.0]", "xy = [0.2, 0.2]")]),
+        "initial_graph.vertices[1]",
+        "convex at every corner",
+    );
+    // A side labelled from the other facet: the central facet's chain no longer leaves
+    // every corner one open sector for the grammar's creases.
+    const NO_SYMMETRY: (&str, &str) = ("[symmetry]\nrotations = 4\ncenter = [0.0, 0.0]", "");
+    refused(
+        flasher_edited(&[
+            NO_SYMMETRY,
+            (
+                "left = \"center\"\nright = \"west\"",
+                "left = \"west\"\nright = \"center\"",
+            ),
+        ]),
+        "initial_graph.creases",
+        "exactly one open sector",
+    );
+}

@@ -136,10 +136,10 @@ impl CreaseGraph {
         Ok(())
     }
 
-    /// The pairs the orbit of pair `m` consists of, each with its roles and the element
-    /// that made it (first occurrence), or `None` when `m.c2` is an image of `m.c1` under
+    /// The pairs the orbit of pair `m` consists of, each with its roles (first occurrence
+    /// of each), or `None` when `m.c2` is an image of `m.c1` under
     /// no involution (`straight`) or at all (r2).
-    fn orbit_pairs(&self, m: R2Match, straight: bool) -> Option<Vec<(R2Match, usize)>> {
+    fn orbit_pairs(&self, m: R2Match, straight: bool) -> Option<Vec<R2Match>> {
         let group = self.group().expect("a symmetric graph");
         let same_orbit = self.orbit_source(m.c1).0 == self.orbit_source(m.c2).0;
         if same_orbit {
@@ -161,15 +161,15 @@ impl CreaseGraph {
                 R2Match { c1: x, c2: y }
             };
             if seen.insert((x.min(y), x.max(y))) {
-                out.push((pair, g));
+                out.push(pair);
             }
         }
         Some(out)
     }
 
     /// The error of the first pair of an orbit that does not match, if any.
-    fn orbit_check(&self, pairs: &[(R2Match, usize)], straight: bool) -> Result<(), RuleError> {
-        for (p, _) in pairs {
+    fn orbit_check(&self, pairs: &[R2Match], straight: bool) -> Result<(), RuleError> {
+        for p in pairs {
             if straight {
                 self.check_combine_straight(p.c1, p.c2)?;
             } else {
@@ -225,7 +225,7 @@ impl CreaseGraph {
         })?;
         self.orbit_check(&pairs, false)?;
         let images = self.pair_images(m);
-        for (k, (p, _)) in pairs.into_iter().enumerate() {
+        for (k, p) in pairs.into_iter().enumerate() {
             self.combine_one(p, k > 0)?;
         }
         // Each element's merged vertex: whichever of its pair survived.
@@ -251,7 +251,7 @@ impl CreaseGraph {
         self.orbit_check(&pairs, true)?;
         let images = self.pair_images(m);
         let mut sinks: Vec<((Vid, Vid), Vid)> = Vec::new();
-        for (k, (p, _)) in pairs.iter().enumerate() {
+        for (k, p) in pairs.iter().enumerate() {
             let v = Vid(self.node_of.len() as u32);
             self.straight_one(*p, k > 0)?;
             sinks.push(((p.c1.min(p.c2), p.c1.max(p.c2)), v));
@@ -306,7 +306,7 @@ impl CreaseGraph {
                 if self.orbit_check(&pairs, straight).is_err() {
                     continue;
                 }
-                let mut key: Vec<(Vid, Vid)> = pairs.iter().map(|(p, _)| (p.c1, p.c2)).collect();
+                let mut key: Vec<(Vid, Vid)> = pairs.iter().map(|p| (p.c1, p.c2)).collect();
                 key.sort_unstable();
                 if !keys.insert(key) {
                     continue;
