@@ -6,7 +6,7 @@
 //! Eq. 25 at t_max is reported as not rigid, with finite coordinates.
 
 mod common;
-use common::Feasibility;
+use common::{Feasibility, assert_gradients, smooth};
 use foldsynth::check::verify::{Tolerances, verify};
 use foldsynth::compile::Options;
 use foldsynth::grammar::{CreaseGraph, Enumeration, Filters};
@@ -112,18 +112,6 @@ fn every_meaningful_graph_composes_its_frames_right() {
     );
 }
 
-/// Whether every vertex triangle at every time of the model is clear of degeneracy.
-fn smooth(model: &Model, x: &[f64], modes: &[f64]) -> bool {
-    let flat = geometry::flat(&model.plan, &model.full_vars(x));
-    model.times.iter().all(|t| {
-        let folded = geometry::fold(&model.plan, &flat, modes, t);
-        folded.states.iter().flatten().all(|st| {
-            let deficit = 2.0 * std::f64::consts::PI - st.u.iter().sum::<f64>();
-            st.margins.iter().all(|m| m.abs() >= 1e-2) && deficit >= 1e-2
-        })
-    })
-}
-
 #[test]
 fn gradients_agree_with_central_differences() {
     let task = task();
@@ -158,28 +146,7 @@ fn gradients_agree_with_central_differences() {
                 continue;
             }
             checked += 1;
-            let h = 1e-6;
-            for j in 0..x.len() {
-                let (mut xp, mut xm) = (x.clone(), x.clone());
-                xp[j] += h;
-                xm[j] -= h;
-                let (fp, gp) = outputs_f64(&model, &xp, &modes);
-                let (fm, gm) = outputs_f64(&model, &xm, &modes);
-                let fd = (fp - fm) / (2.0 * h);
-                assert!(
-                    (fd - e.df[j]).abs() <= 1e-5 * (1.0 + fd.abs()),
-                    "{seq} ∂f/∂x{j}: {fd} vs {}",
-                    e.df[j]
-                );
-                for k in 0..gp.len() {
-                    let fd = (gp[k] - gm[k]) / (2.0 * h);
-                    let an = e.dg[k * x.len() + j];
-                    assert!(
-                        (fd - an).abs() <= 1e-5 * (1.0 + fd.abs()),
-                        "{seq} ∂g{k}/∂x{j}: {fd} vs {an}"
-                    );
-                }
-            }
+            assert_gradients(&model, &e, &x, &modes, seq);
         }
     }
     assert!(checked >= 30, "only {checked} smooth points checked");

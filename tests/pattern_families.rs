@@ -9,6 +9,8 @@
 
 #![allow(clippy::needless_range_loop)] // coordinates by index read as the formulas
 
+mod common;
+use common::{assert_gradients, smooth};
 use foldsynth::grammar::CreaseGraph;
 use foldsynth::model::geometry;
 use foldsynth::model::plan::{Plan, Position};
@@ -160,19 +162,6 @@ fn side_vertex_joins_two_sectors() {
     }
 }
 
-/// Every vertex triangle of the model's states away from its kinks (margins and the
-/// perimeter deficit 2π − ΣU at least 1e-2), where central differences mean something.
-fn smooth(model: &foldsynth::model::Model, x: &[f64], modes: &[f64]) -> bool {
-    let flat = geometry::flat(&model.plan, &model.full_vars(x));
-    model.times.iter().all(|t| {
-        let folded = geometry::fold(&model.plan, &flat, modes, t);
-        folded.states.iter().flatten().all(|st| {
-            let deficit = 2.0 * std::f64::consts::PI - st.u.iter().sum::<f64>();
-            st.margins.iter().all(|m| m.abs() >= 1e-2) && deficit >= 1e-2
-        })
-    })
-}
-
 #[test]
 fn corners_with_two_driven_creases_compile_to_the_f64_kinematics_and_their_gradients() {
     use foldsynth::compile::Options;
@@ -221,28 +210,7 @@ fn corners_with_two_driven_creases_compile_to_the_f64_kinematics_and_their_gradi
                     continue;
                 }
                 differentiated += 1;
-                let h = 1e-6;
-                for j in 0..x.len() {
-                    let (mut xp, mut xm) = (x.clone(), x.clone());
-                    xp[j] += h;
-                    xm[j] -= h;
-                    let (fp, gp) = outputs_f64(&model, &xp, &modes);
-                    let (fm, gm) = outputs_f64(&model, &xm, &modes);
-                    let fd = (fp - fm) / (2.0 * h);
-                    assert!(
-                        (fd - e.df[j]).abs() <= 1e-5 * (1.0 + fd.abs()),
-                        "{seq} ∂f/∂x{j}: {fd} vs {}",
-                        e.df[j]
-                    );
-                    for k in 0..gp.len() {
-                        let fd = (gp[k] - gm[k]) / (2.0 * h);
-                        let an = e.dg[k * x.len() + j];
-                        assert!(
-                            (fd - an).abs() <= 1e-5 * (1.0 + fd.abs()),
-                            "{seq} ∂g{k}/∂x{j}: {fd} vs {an}"
-                        );
-                    }
-                }
+                assert_gradients(&model, &e, &x, &modes, seq);
             }
         }
     }
@@ -280,31 +248,31 @@ fn the_rigid_flasher_is_a_meaningful_graph_of_the_cuboid_task() {
         assert_eq!(plan.vertices[c].rays.len(), 5, "corner v{}", c + 1);
     }
     let sector_of = |v: usize| plan.orbit[v].1;
-    let pred_sets: Vec<Vec<usize>> = (0..plan.vertices.len())
+    // Every vertex with two incoming creases, with their tails.
+    let pred_sets: Vec<(usize, Vec<usize>)> = (0..plan.vertices.len())
         .filter(|&v| plan.vertices[v].preds == 2)
-        .map(|v| plan.vertices[v].rays[..2].iter().map(|r| r.other).collect())
-        .collect();
-    // Side vertices: two corners of the central facet from neighbouring sectors.
-    let sides: Vec<&Vec<usize>> = pred_sets
-        .iter()
-        .filter(|p| p.iter().all(|v| corners.contains(v)))
-        .collect();
-    assert_eq!(sides.len(), 4, "one side vertex per side");
-    for p in &sides {
-        assert_ne!(sector_of(p[0]), sector_of(p[1]));
-    }
-    let side_vertices: Vec<usize> = (0..plan.vertices.len())
-        .filter(|&v| {
-            plan.vertices[v].preds == 2
-                && plan.vertices[v].rays[..2]
-                    .iter()
-                    .all(|r| corners.contains(&r.other))
+        .map(|v| {
+            (
+                v,
+                plan.vertices[v].rays[..2].iter().map(|r| r.other).collect(),
+            )
         })
         .collect();
+    // Side vertices: two corners of the central facet from neighbouring sectors.
+    let side_vertices: Vec<usize> = pred_sets
+        .iter()
+        .filter(|(_, p)| p.iter().all(|v| corners.contains(v)))
+        .map(|(v, p)| {
+            assert_ne!(sector_of(p[0]), sector_of(p[1]));
+            *v
+        })
+        .collect();
+    assert_eq!(side_vertices.len(), 4, "one side vertex per side");
     // Second layer: 8 vertices, each joined to one side vertex and one diagonal end (a
     // corner's successor that is not a side vertex).
     let layer2: Vec<&Vec<usize>> = pred_sets
         .iter()
+        .map(|(_, p)| p)
         .filter(|p| p.iter().any(|v| side_vertices.contains(v)))
         .collect();
     assert_eq!(layer2.len(), 8, "{pred_sets:?}");
