@@ -7,9 +7,11 @@
 //! the file); `.fold` a FOLD file and `.json` a design (`designs/<id>.json`, or any
 //! `{"pattern": …}`). Those two are driven like the design tasks (SPEC §4, see
 //! [`crate::simulate::crossval`]): the crease marked driven (`edges_foldsynth:driven`,
-//! or `--driven`) is folded to ρ(t) mirror-symmetrically, with ρ read from the frames (or
-//! `--angle`); their frames are the PTU's motion, so every simulated state that has a
-//! frame is compared with it.
+//! or `--driven`) is folded to ρ(t) mirror-symmetrically, or, where several marked
+//! creases bound one facet (a driven central facet), that facet stays fixed and each
+//! crease turns the facet across it; ρ is read from the frames (or `--angle`). Their
+//! frames are the PTU's motion, so every simulated state that has a frame is compared
+//! with it.
 
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -25,7 +27,7 @@ use serde_json::json;
 use crate::export::fold::FoldFile;
 use crate::pattern::Pattern;
 use crate::simulate::crossval::{
-    self, CrossvalOptions, CrossvalReport, G0Drive, GAMMA_TOL, POSITION_TOL,
+    self, CrossvalOptions, CrossvalReport, DrivenCrease, G0Drive, GAMMA_TOL, POSITION_TOL,
 };
 use crate::simulate::{Formula, PatternFile, RIGID_DELTA, SimReport, simulate};
 
@@ -44,11 +46,11 @@ pub struct SimulateArgs {
     /// one step per frame after the first, or 30 without frames).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=crate::limits::STEPS_MAX))]
     pub steps: Option<u64>,
-    /// FOLD/design: the driven crease (0-based edge index; default: the edge marked
-    /// driven).
+    /// FOLD/design: the driven crease, folded symmetrically (0-based edge index; default:
+    /// the edges marked driven: one, or the sides of a central facet that stays fixed).
     #[arg(long, value_name = "EDGE")]
     pub driven: Option<usize>,
-    /// FOLD/design: the driven crease's fold angle as a formula in t, valley positive,
+    /// FOLD/design: the driven creases' fold angle as a formula in t, valley positive,
     /// 0 at the start (default: read from the frames; "t" without frames).
     #[arg(long, value_name = "FORMULA", allow_hyphen_values = true)]
     pub angle: Option<String>,
@@ -218,28 +220,47 @@ pub fn read_design(path: &Path) -> anyhow::Result<(String, Pattern)> {
     Ok((name, pattern))
 }
 
-/// The G0 drive for a FOLD/design pattern from the flags and the pattern.
+/// The G0 drive for a FOLD/design pattern from the flags and the pattern: `--driven EDGE`
+/// folds that one crease symmetrically; otherwise every marked crease is driven (one, or
+/// the sides of a central facet that stays fixed, [`G0Drive::of_creases`]). Each crease's
+/// angle is `--angle`, else its frames', else t.
 fn drive_for(pattern: &Pattern, args: &SimulateArgs) -> anyhow::Result<G0Drive> {
-    let edge = match args.driven {
-        Some(e) => e,
-        None => G0Drive::marked_edge(pattern)?,
+    let edges = match args.driven {
+        Some(e) => vec![e],
+        None => G0Drive::marked_edges(pattern)?,
     };
-    if let Some(src) = &args.angle {
-        let f = Formula::parse(src).map_err(|e| anyhow::anyhow!("--angle: {e}"))?;
-        return Ok(G0Drive {
-            edge,
-            source: src.clone(),
-            angle: Arc::new(move |t| f.eval(t)),
-        });
+    let formula = match &args.angle {
+        Some(src) => {
+            let f = Formula::parse(src).map_err(|e| anyhow::anyhow!("--angle: {e}"))?;
+            Some((f, src.clone()))
+        }
+        None => None,
+    };
+    let mut creases = Vec::with_capacity(edges.len());
+    for edge in edges {
+        let crease = match &formula {
+            Some((f, src)) => {
+                let f = f.clone();
+                DrivenCrease {
+                    edge,
+                    source: src.clone(),
+                    angle: Arc::new(move |t| f.eval(t)),
+                }
+            }
+            None if pattern.frames.is_empty() => DrivenCrease {
+                edge,
+                source: "t".into(),
+                angle: Arc::new(|t| t),
+            },
+            None => DrivenCrease::from_frames(pattern, edge)?,
+        };
+        creases.push(crease);
     }
-    if pattern.frames.is_empty() {
-        return Ok(G0Drive {
-            edge,
-            source: "t".into(),
-            angle: Arc::new(|t| t),
-        });
+    if args.driven.is_some() {
+        // One named crease: the symmetric fold, whatever else the file marks.
+        return Ok(G0Drive::Symmetric(creases.remove(0)));
     }
-    Ok(G0Drive::from_frames(pattern, edge)?)
+    Ok(G0Drive::of_creases(pattern, creases)?)
 }
 
 fn parse_t_max(src: &str) -> anyhow::Result<f64> {
@@ -344,18 +365,28 @@ fn pattern_text(
     r: &CrossvalReport,
     note: Option<&str>,
 ) {
-    let [p, q] = pattern.edges[drive.edge].v;
+    let creases: Vec<String> = drive
+        .creases()
+        .iter()
+        .map(|c| {
+            let [p, q] = pattern.edges[c.edge].v;
+            format!("{} ({p}→{q})", c.edge)
+        })
+        .collect();
+    let driven = match drive.fixed_face() {
+        None => format!("driven crease {}", creases.join(", ")),
+        Some(f) => format!("facet {f} fixed, driven creases {}", creases.join(", ")),
+    };
     let _ = writeln!(o, "{name}");
     let _ = writeln!(
         o,
-        "{} vertices ({} free), {} facets, {} bars, J = {}; driven crease {} ({p}→{q}), ρ(t) = {}, t ∈ [{:.6}, {:.6}]",
+        "{} vertices ({} free), {} facets, {} bars, J = {}; {driven}, ρ(t) = {}, t ∈ [{:.6}, {:.6}]",
         pattern.vertices.len(),
         r.free_vertices,
         pattern.faces.len(),
         r.bars,
         r.steps,
-        drive.edge,
-        drive.source,
+        drive.source(),
         r.t_start,
         r.t_end
     );
@@ -417,7 +448,7 @@ fn design_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
 fn run_crossval(dir: &Path, args: &SimulateArgs) -> anyhow::Result<()> {
     if args.angle.is_some() || args.t_max.is_some() || args.driven.is_some() {
         bail!(
-            "--crossval drives every design by its marked crease over its frames; --driven, --angle and --t-max do not apply"
+            "--crossval drives every design by its marked creases over its frames; --driven, --angle and --t-max do not apply"
         );
     }
     let files = design_files(dir)?;
@@ -460,8 +491,7 @@ fn crossval_rows(files: &[PathBuf], opts: &CrossvalOptions) -> Vec<Row> {
                 result: Err(format!("{e:#}")),
             },
             Ok((name, pattern)) => {
-                let result = G0Drive::marked_edge(&pattern)
-                    .and_then(|e| G0Drive::from_frames(&pattern, e))
+                let result = G0Drive::from_frames(&pattern)
                     .and_then(|d| crossval::crossval(&pattern, &d, opts))
                     .map_err(|e| e.to_string());
                 Row {

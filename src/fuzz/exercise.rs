@@ -143,27 +143,20 @@ pub fn fold(text: &str) -> bool {
         // which would dominate the run.
         if p.vertices.len() <= 16
             && text.len().is_multiple_of(16)
-            && let Ok(edge) = G0Drive::marked_edge(&p)
+            && let Ok(drive) = G0Drive::from_frames(&p)
         {
-            let drive = if p.frames.is_empty() {
-                None
-            } else {
-                G0Drive::from_frames(&p, edge).ok()
-            };
-            if let Some(drive) = drive {
-                let _ = crossval(
-                    &p,
-                    &drive,
-                    &CrossvalOptions {
-                        steps: Some(1),
-                        solver: SolverSettings {
-                            refine_budget: REFINE_ITERATION_BUDGET / 10,
-                            ..CrossvalOptions::default().solver
-                        },
-                        ..CrossvalOptions::default()
+            let _ = crossval(
+                &p,
+                &drive,
+                &CrossvalOptions {
+                    steps: Some(1),
+                    solver: SolverSettings {
+                        refine_budget: REFINE_ITERATION_BUDGET / 10,
+                        ..CrossvalOptions::default().solver
                     },
-                );
-            }
+                    ..CrossvalOptions::default()
+                },
+            );
         }
     }
     true

@@ -5,17 +5,24 @@
 //! the model computed. The simulator gets the same flat layout and facets, and the motion
 //! the PTU prescribes for the design task's actuation (SPEC §4), [`G0Drive`]:
 //!
-//! * the two ends of the driven crease stay at their flat positions;
-//! * every vertex of the facet left of the crease (tail → head) turns by +ρ(t)/2 about the
-//!   crease, every vertex of the facet right of it by −ρ(t)/2;
+//! * a symmetric fold (the gripper's one crease): the two ends of the driven crease stay at
+//!   their flat positions; every vertex of the facet left of the crease (tail → head)
+//!   turns by +ρ(t)/2 about the crease, every vertex of the facet right of it by −ρ(t)/2;
+//! * a driven central facet (`grammar/flasher_cuboid.toml`, `grammar/star.toml`): the
+//!   fixed facet's vertices stay at their flat positions; across each driven crease (each
+//!   side's two halves), the facet turns by that crease's ρ(t) about it;
 //! * every other vertex is free: only the bars place it.
 //!
-//! Why trajectories and not a crease drive with one facet fixed: the PTU *defines* the
-//! maps of those two facets as exactly these rotations ([`crate::model::geometry::fold`]),
-//! so prescribing their vertices is exact, adds no approximation, and leaves the simulated
-//! states in the PTU's own frame — positions compare directly, without aligning frames. A
-//! crease drive would move the whole pattern by the rigid motion Rot(−ρ/2) relative to the
-//! PTU, exact too, but only after an alignment that could hide an error of its own.
+//! Both are one list of prescribed facets with their rigid maps
+//! ([`G0Drive::prescribed_facets`]); a vertex on several (a corner of the central facet,
+//! a side's midpoint) is fixed when one of them keeps it, and must be placed alike by all.
+//!
+//! Why trajectories and not crease drives: the PTU *defines* the maps of those facets as
+//! exactly these rotations ([`crate::model::geometry::fold`]), so prescribing their
+//! vertices is exact, adds no approximation, and leaves the simulated states in the PTU's
+//! own frame — positions compare directly, without aligning frames. A crease drive of the
+//! symmetric fold would move the whole pattern by the rigid motion Rot(−ρ/2) relative to
+//! the PTU, exact too, but only after an alignment that could hide an error of its own.
 //!
 //! The flat state is a bifurcation (every crease can start either way), so the first step
 //! starts from the PTU's own first state ([`SimInput::first_step_offsets`] = X(t₁) − X(0)
@@ -48,7 +55,7 @@ use nalgebra::{Rotation3, Unit, Vector3};
 use serde::Serialize;
 use thiserror::Error;
 
-use super::input::{AngleFn, Drive, SimInput, SolverSettings};
+use super::input::{AngleFn, Drive, PathFn, SimInput, SolverSettings};
 use super::run::{RIGID_DELTA, SimError, SimReport, simulate_with_checker};
 use super::solver::{Bars, jacobian};
 use crate::check::{CheckError, Checker};
@@ -103,11 +110,40 @@ pub enum CrossvalError {
         "no crease is marked as driven (a foldsynth design marks G0's crease; name it with --driven EDGE)"
     )]
     NoDrivenCrease,
-    /// More than one edge is marked driven; G0 drives one.
+    /// Several edges are marked driven, but neither on one line between the same two
+    /// facets (a symmetric fold) nor all bounding one facet (a fixed central facet).
     #[error(
-        "edges {0:?} are all marked as driven; the design task's actuation drives exactly one crease (name it with --driven EDGE)"
+        "edges {0:?} are all marked as driven, but they neither lie between the same two facets nor all bound one facet that could stay fixed (name one crease with --driven EDGE)"
     )]
     SeveralDrivenCreases(Vec<usize>),
+    /// The fixed facet does not exist.
+    #[error("facet {face} does not exist (the pattern has {count} facets, 0-based)")]
+    FaceOutOfRange {
+        /// The facet asked for.
+        face: usize,
+        /// Number of facets.
+        count: usize,
+    },
+    /// A driven crease of a fixed-facet actuation does not bound the fixed facet.
+    #[error("driven crease {edge} does not bound the fixed facet {face}")]
+    NotOnFixedFacet {
+        /// The crease.
+        edge: usize,
+        /// The fixed facet.
+        face: usize,
+    },
+    /// Two prescribed facets would put one vertex at different places.
+    #[error(
+        "vertex {vertex} is moved differently by prescribed facet {face} (by {gap:e} at the end of the motion): the driven creases do not move the paper consistently"
+    )]
+    ConflictingPrescription {
+        /// The vertex.
+        vertex: usize,
+        /// The facet that disagrees with the vertex's first prescription.
+        face: usize,
+        /// Distance between the two places at t_end.
+        gap: f64,
+    },
     /// The driven edge does not exist.
     #[error("edge {edge} does not exist (the pattern has {count} edges, 0-based)")]
     EdgeOutOfRange {
@@ -159,10 +195,10 @@ pub enum CrossvalError {
     Sim(#[from] SimError),
 }
 
-/// The design task's actuation (SPEC §4): crease `edge` of the pattern, run tail → head
-/// (`edges[edge].v[0] → v[1]`), folded to `angle(t)` mirror-symmetrically.
+/// One driven crease of the design task's actuation (SPEC §4): edge `edge` of the pattern,
+/// run tail → head (`edges[edge].v[0] → v[1]`), folded to `angle(t)`.
 #[derive(Clone)]
-pub struct G0Drive {
+pub struct DrivenCrease {
     /// Index into [`Pattern::edges`].
     pub edge: usize,
     /// The fold angle ρ(t), valley positive; ρ(t_start) must be 0.
@@ -171,38 +207,21 @@ pub struct G0Drive {
     pub source: String,
 }
 
-impl std::fmt::Debug for G0Drive {
+impl std::fmt::Debug for DrivenCrease {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("G0Drive")
+        f.debug_struct("DrivenCrease")
             .field("edge", &self.edge)
             .field("source", &self.source)
             .finish_non_exhaustive()
     }
 }
 
-impl G0Drive {
-    /// The one edge of `pattern` marked as a driven crease.
-    pub fn marked_edge(pattern: &Pattern) -> Result<usize, CrossvalError> {
-        let driven: Vec<usize> = pattern
-            .edges
-            .iter()
-            .enumerate()
-            .filter(|(_, e)| matches!(e.kind, EdgeKind::Crease { driven: true }))
-            .map(|(i, _)| i)
-            .collect();
-        match driven.as_slice() {
-            [] => Err(CrossvalError::NoDrivenCrease),
-            [e] => Ok(*e),
-            _ => Err(CrossvalError::SeveralDrivenCreases(driven)),
-        }
-    }
-
-    /// The drive of crease `edge` with the fold angle its frames show: `ρ(t) = t` when every
-    /// frame has exactly that (the design tasks' `drive = "t"`, then exact at every t);
-    /// otherwise the piecewise-linear interpolation of the frames' angles (exact at the
-    /// frames, which are the states compared; between them it only guides the solver's
-    /// trial half steps).
-    pub fn from_frames(pattern: &Pattern, edge: usize) -> Result<G0Drive, CrossvalError> {
+impl DrivenCrease {
+    /// Crease `edge` with the fold angle its frames show: `ρ(t) = t` when every frame has
+    /// exactly that (the design tasks' `drive = "t"`, then exact at every t); otherwise the
+    /// piecewise-linear interpolation of the frames' angles (exact at the frames, which are
+    /// the states compared; between them it only guides the solver's trial half steps).
+    pub fn from_frames(pattern: &Pattern, edge: usize) -> Result<DrivenCrease, CrossvalError> {
         check_edge(pattern, edge)?;
         let mut pts: Vec<(f64, f64)> = pattern
             .frames
@@ -223,7 +242,7 @@ impl G0Drive {
             .iter()
             .all(|(t, a)| (a - t).abs() <= SAME_T * t.abs().max(1.0))
         {
-            return Ok(G0Drive {
+            return Ok(DrivenCrease {
                 edge,
                 angle: Arc::new(|t| t),
                 source: "t".into(),
@@ -246,10 +265,237 @@ impl G0Drive {
             let tau = std::f64::consts::TAU;
             pts[k].1 -= tau * ((pts[k].1 - prev) / tau).round();
         }
-        Ok(G0Drive {
+        Ok(DrivenCrease {
             edge,
             angle: Arc::new(move |t| interpolate(&pts, t)),
             source: "frames (interpolated)".into(),
+        })
+    }
+}
+
+/// The design task's actuation (SPEC §4, `model::plan::Actuation`): how the driven creases
+/// move the paper.
+#[derive(Clone, Debug)]
+pub enum G0Drive {
+    /// One crease folded mirror-symmetrically (the gripper's G0): the facet left of it
+    /// (tail → head) turns by +ρ(t)/2 about it, the facet right of it by −ρ(t)/2.
+    Symmetric(DrivenCrease),
+    /// A facet that stays in place (a driven central facet, thesis Sec. 3.4, 4.3) and the
+    /// driven creases that bound it: across each, the other facet turns by that crease's
+    /// ρ(t) about it, +ρ about tail → head when it lies left of the crease, −ρ when right
+    /// (`model::geometry::fold`: crossing a crease from its right facet to its left turns
+    /// by +ρ).
+    Fixed {
+        /// The fixed facet (index into [`Pattern::faces`]).
+        face: usize,
+        /// Every driven crease; each has `face` on one side.
+        creases: Vec<DrivenCrease>,
+    },
+}
+
+impl G0Drive {
+    /// The edges of `pattern` marked as driven creases (at least one).
+    pub fn marked_edges(pattern: &Pattern) -> Result<Vec<usize>, CrossvalError> {
+        let driven: Vec<usize> = pattern
+            .edges
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| matches!(e.kind, EdgeKind::Crease { driven: true }))
+            .map(|(i, _)| i)
+            .collect();
+        if driven.is_empty() {
+            return Err(CrossvalError::NoDrivenCrease);
+        }
+        Ok(driven)
+    }
+
+    /// The actuation of a pattern with these driven creases, read as the task language
+    /// reads G0 (docs/tasks.md, `initial_graph.fixed`): one crease, or several between the
+    /// same two facets (one line split at degree-2 vertices), folds symmetrically by the
+    /// first crease's angle; several that all bound one facet keep that facet fixed.
+    pub fn of_creases(
+        pattern: &Pattern,
+        creases: Vec<DrivenCrease>,
+    ) -> Result<G0Drive, CrossvalError> {
+        let edges: Vec<usize> = creases.iter().map(|c| c.edge).collect();
+        for &e in &edges {
+            check_edge(pattern, e)?;
+        }
+        let bounds_all = |f: &Vec<usize>| {
+            edges.iter().all(|&e| {
+                let [p, q] = pattern.edges[e].v;
+                traverses(f, p, q) || traverses(f, q, p)
+            })
+        };
+        let common: Vec<usize> = (0..pattern.faces.len())
+            .filter(|&f| bounds_all(&pattern.faces[f]))
+            .collect();
+        let mut creases = creases;
+        match (creases.len(), common.as_slice()) {
+            (0, _) => Err(CrossvalError::NoDrivenCrease),
+            (1, _) | (_, [_, _]) => Ok(G0Drive::Symmetric(creases.swap_remove(0))),
+            (_, [face]) => Ok(G0Drive::Fixed {
+                face: *face,
+                creases,
+            }),
+            _ => Err(CrossvalError::SeveralDrivenCreases(edges)),
+        }
+    }
+
+    /// The actuation of `pattern`'s marked creases ([`G0Drive::of_creases`]) with the fold
+    /// angles its frames show ([`DrivenCrease::from_frames`]).
+    pub fn from_frames(pattern: &Pattern) -> Result<G0Drive, CrossvalError> {
+        let creases = G0Drive::marked_edges(pattern)?
+            .into_iter()
+            .map(|e| DrivenCrease::from_frames(pattern, e))
+            .collect::<Result<Vec<_>, _>>()?;
+        G0Drive::of_creases(pattern, creases)
+    }
+
+    /// The driven creases (the symmetric fold's one first).
+    pub fn creases(&self) -> &[DrivenCrease] {
+        match self {
+            G0Drive::Symmetric(c) => std::slice::from_ref(c),
+            G0Drive::Fixed { creases, .. } => creases,
+        }
+    }
+
+    /// The fixed facet, if any.
+    pub fn fixed_face(&self) -> Option<usize> {
+        match self {
+            G0Drive::Symmetric(_) => None,
+            G0Drive::Fixed { face, .. } => Some(*face),
+        }
+    }
+
+    /// Where the angles come from: the one source, or every crease's where they differ.
+    pub fn source(&self) -> String {
+        let all: Vec<&str> = self.creases().iter().map(|c| c.source.as_str()).collect();
+        if all.iter().all(|s| *s == all[0]) {
+            all[0].to_string()
+        } else {
+            all.join("; ")
+        }
+    }
+
+    /// The facets this actuation moves, each with its rigid motion (see
+    /// [`PrescribedFacet`]): the symmetric fold's two, or the fixed facet and the facet
+    /// across each driven crease.
+    pub fn prescribed_facets(
+        &self,
+        pattern: &Pattern,
+    ) -> Result<Vec<PrescribedFacet>, CrossvalError> {
+        match self {
+            G0Drive::Symmetric(c) => {
+                let [left, right] = facets_of(pattern, c.edge)?;
+                Ok([(left, 0.5), (right, -0.5)]
+                    .into_iter()
+                    .map(|(face, scale)| PrescribedFacet {
+                        face,
+                        turn: Some(Turn::of(pattern, c, scale)),
+                    })
+                    .collect())
+            }
+            G0Drive::Fixed { face, creases } => {
+                if creases.is_empty() {
+                    return Err(CrossvalError::NoDrivenCrease);
+                }
+                if *face >= pattern.faces.len() {
+                    return Err(CrossvalError::FaceOutOfRange {
+                        face: *face,
+                        count: pattern.faces.len(),
+                    });
+                }
+                let mut out = vec![PrescribedFacet {
+                    face: *face,
+                    turn: None,
+                }];
+                for c in creases {
+                    let [left, right] = facets_of(pattern, c.edge)?;
+                    let (moving, scale) = if right == *face {
+                        (left, 1.0)
+                    } else if left == *face {
+                        (right, -1.0)
+                    } else {
+                        return Err(CrossvalError::NotOnFixedFacet {
+                            edge: c.edge,
+                            face: *face,
+                        });
+                    };
+                    out.push(PrescribedFacet {
+                        face: moving,
+                        turn: Some(Turn::of(pattern, c, scale)),
+                    });
+                }
+                Ok(out)
+            }
+        }
+    }
+}
+
+/// A facet whose vertices the actuation places: at its flat position (`turn` `None`) or
+/// turned rigidly about a driven crease. Vertices on the crease (its two ends) stay where
+/// they are; a vertex of several prescribed facets must be placed alike by all.
+#[derive(Clone, Debug)]
+pub struct PrescribedFacet {
+    /// Index into [`Pattern::faces`].
+    pub face: usize,
+    /// How it turns; `None`: it stays.
+    pub turn: Option<Turn>,
+}
+
+/// A rigid turn about the line `tail → head` of the flat layout (right-handed) by
+/// `scale · (ρ(t) − ρ(t_start))`.
+#[derive(Clone)]
+pub struct Turn {
+    /// The crease's first end.
+    pub tail: usize,
+    /// Its second end.
+    pub head: usize,
+    /// Multiplies the fold angle: ±1/2 for the symmetric fold, ±1 about a fixed facet.
+    pub scale: f64,
+    /// The crease's fold angle ρ(t).
+    pub angle: AngleFn,
+}
+
+impl std::fmt::Debug for Turn {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Turn")
+            .field("tail", &self.tail)
+            .field("head", &self.head)
+            .field("scale", &self.scale)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Turn {
+    fn of(pattern: &Pattern, c: &DrivenCrease, scale: f64) -> Turn {
+        let [tail, head] = pattern.edges[c.edge].v;
+        Turn {
+            tail,
+            head,
+            scale,
+            angle: c.angle.clone(),
+        }
+    }
+
+    /// Whether vertex `v` is on the line it turns about (one of the crease's ends).
+    fn keeps(&self, v: usize) -> bool {
+        v == self.tail || v == self.head
+    }
+
+    /// The path of the flat point `p` under this turn, from `t_start`.
+    fn path(&self, initial: &[[f64; 3]], p: [f64; 3], t_start: f64) -> PathFn {
+        let origin = Vector3::from(initial[self.tail]);
+        let axis = Unit::new_normalize(Vector3::from(initial[self.head]) - origin);
+        let p = Vector3::from(p) - origin;
+        let (angle, sign) = (self.angle.clone(), self.scale);
+        let rho0 = (self.angle)(t_start);
+        // Subtract ρ(t_start) so the path starts exactly at the flat position.
+        Arc::new(move |t| {
+            let r = Rotation3::from_axis_angle(&axis, sign * (angle(t) - rho0));
+            let x = origin + r * p;
+            [x.x, x.y, x.z]
         })
     }
 }
@@ -280,10 +526,32 @@ fn traverses(f: &[usize], p: usize, q: usize) -> bool {
     (0..f.len()).any(|k| f[k] == p && f[(k + 1) % f.len()] == q)
 }
 
+/// The facets left and right of crease `edge` (tail → head), exactly one each.
+fn facets_of(pattern: &Pattern, edge: usize) -> Result<[usize; 2], CrossvalError> {
+    check_edge(pattern, edge)?;
+    let [tail, head] = pattern.edges[edge].v;
+    let side = |p: usize, q: usize| -> Vec<usize> {
+        (0..pattern.faces.len())
+            .filter(|&f| traverses(&pattern.faces[f], p, q))
+            .collect()
+    };
+    let (left, right) = (side(tail, head), side(head, tail));
+    match (left.as_slice(), right.as_slice()) {
+        ([l], [r]) => Ok([*l, *r]),
+        _ => Err(CrossvalError::NotBetweenTwoFacets {
+            edge,
+            tail,
+            head,
+            left: left.len(),
+            right: right.len(),
+        }),
+    }
+}
+
 /// The simulator input of `pattern` driven by `drive` over `[t_start, t_end]` in `steps`
-/// steps, starting from the flat layout: the driven crease's ends fixed, the vertices of
-/// its two facets on their rotations, everything else free. No branch offsets (see
-/// [`branch_offsets`]) and no intersection check; the caller adds them.
+/// steps, starting from the flat layout: the vertices of the prescribed facets
+/// ([`G0Drive::prescribed_facets`]) fixed or on their turns, everything else free. No
+/// branch offsets (see [`branch_offsets`]) and no intersection check; the caller adds them.
 pub fn g0_input(
     pattern: &Pattern,
     drive: &G0Drive,
@@ -291,62 +559,28 @@ pub fn g0_input(
     t_end: f64,
     steps: usize,
 ) -> Result<SimInput, CrossvalError> {
-    check_edge(pattern, drive.edge)?;
-    let [tail, head] = pattern.edges[drive.edge].v;
-    let left: Vec<usize> = (0..pattern.faces.len())
-        .filter(|&f| traverses(&pattern.faces[f], tail, head))
-        .collect();
-    let right: Vec<usize> = (0..pattern.faces.len())
-        .filter(|&f| traverses(&pattern.faces[f], head, tail))
-        .collect();
-    if left.len() != 1 || right.len() != 1 {
-        return Err(CrossvalError::NotBetweenTwoFacets {
-            edge: drive.edge,
-            tail,
-            head,
-            left: left.len(),
-            right: right.len(),
-        });
-    }
+    let facets = drive.prescribed_facets(pattern)?;
     if !t_start.is_finite() || !t_end.is_finite() {
         return Err(CrossvalError::Motion(
             "the range of t must be finite".into(),
         ));
     }
-    let rho0 = (drive.angle)(t_start);
-    if rho0.is_nan() || rho0.abs() > 1e-12 {
-        return Err(CrossvalError::NotFlatAtStart {
-            t_start,
-            angle: rho0,
-        });
-    }
-    let initial = pattern.flat_coords();
-    let origin = Vector3::from(initial[tail]);
-    let axis = Unit::new_normalize(Vector3::from(initial[head]) - origin);
-    let mut drives = Vec::new();
-    for (face, sign) in [(left[0], 0.5), (right[0], -0.5)] {
-        for &v in &pattern.faces[face] {
-            if v == tail || v == head {
-                continue;
-            }
-            let p = Vector3::from(initial[v]) - origin;
-            let angle = drive.angle.clone();
-            // Subtract ρ(t_start) so the path starts exactly at the flat position.
-            drives.push(Drive::Trajectory {
-                vertex: v,
-                path: Arc::new(move |t| {
-                    let r = Rotation3::from_axis_angle(&axis, sign * (angle(t) - rho0));
-                    let x = origin + r * p;
-                    [x.x, x.y, x.z]
-                }),
+    for c in drive.creases() {
+        let rho0 = (c.angle)(t_start);
+        if rho0.is_nan() || rho0.abs() > 1e-12 {
+            return Err(CrossvalError::NotFlatAtStart {
+                t_start,
+                angle: rho0,
             });
         }
     }
+    let initial = pattern.flat_coords();
+    let (fixed, drives) = prescribe(pattern, &facets, &initial, t_start, t_end)?;
     Ok(SimInput {
         initial,
         faces: pattern.faces.clone(),
         extra_bars: Vec::new(),
-        fixed: vec![tail, head],
+        fixed,
         drives,
         t_start,
         t_end,
@@ -355,6 +589,64 @@ pub fn g0_input(
         check_intersections: false,
         solver: SolverSettings::default(),
     })
+}
+
+/// Two prescriptions of one vertex agree when they differ by at most this at t_end (paper
+/// units): rounding of a rotation about a line through the vertex, far below any feature.
+const SAME_PLACE: f64 = 1e-9;
+
+/// The fixed vertices and the trajectories of `facets`: a vertex that some prescribed
+/// facet keeps (a static facet, or the ends of its crease) is fixed; otherwise it follows
+/// the first facet that moves it. Every other facet holding it must put it at the same
+/// place at t_end, or the actuation contradicts itself (an error, not a guess).
+fn prescribe(
+    pattern: &Pattern,
+    facets: &[PrescribedFacet],
+    initial: &[[f64; 3]],
+    t_start: f64,
+    t_end: f64,
+) -> Result<(Vec<usize>, Vec<Drive>), CrossvalError> {
+    let n = initial.len();
+    let mut kept = vec![false; n];
+    for pf in facets {
+        for &v in &pattern.faces[pf.face] {
+            kept[v] |= pf.turn.as_ref().is_none_or(|turn| turn.keeps(v));
+        }
+    }
+    let fixed: Vec<usize> = (0..n).filter(|&v| kept[v]).collect();
+    let mut drives = Vec::new();
+    let mut paths: Vec<Option<PathFn>> = vec![None; n];
+    // Facet order, then each facet's vertex order: the order the drives always had.
+    for pf in facets {
+        let Some(turn) = &pf.turn else { continue };
+        for &v in &pattern.faces[pf.face] {
+            if kept[v] || paths[v].is_some() || turn.keeps(v) {
+                continue;
+            }
+            let path = turn.path(initial, initial[v], t_start);
+            paths[v] = Some(path.clone());
+            drives.push(Drive::Trajectory { vertex: v, path });
+        }
+    }
+    for pf in facets {
+        for &v in &pattern.faces[pf.face] {
+            let here = match &pf.turn {
+                Some(turn) if !turn.keeps(v) => turn.path(initial, initial[v], t_start)(t_end),
+                _ => initial[v],
+            };
+            let there = paths[v].as_ref().map_or(initial[v], |p| p(t_end));
+            // A NaN (a drive undefined at t_end) is left to the simulation to report.
+            let gap = geom::dist(here, there);
+            if gap > SAME_PLACE {
+                return Err(CrossvalError::ConflictingPrescription {
+                    vertex: v,
+                    face: pf.face,
+                    gap,
+                });
+            }
+        }
+    }
+    Ok((fixed, drives))
 }
 
 /// The apex of a rigid panel: a vertex off the facet's plane joined by bars to every
@@ -524,9 +816,13 @@ pub struct StateComparison {
 /// The outcome of one cross-validation.
 #[derive(Clone, Debug, Serialize)]
 pub struct CrossvalReport {
-    /// The driven crease (edge index).
+    /// The (first) driven crease (edge index).
     pub driven_edge: usize,
-    /// Where its fold angle came from.
+    /// Every driven crease (edge indices).
+    pub driven_edges: Vec<usize>,
+    /// The facet the actuation keeps fixed (a driven central facet), if any.
+    pub fixed_face: Option<usize>,
+    /// Where the fold angles came from.
     pub angle_source: String,
     /// J.
     pub steps: usize,
@@ -553,8 +849,8 @@ pub struct CrossvalReport {
     pub widened_states: usize,
     /// Position error at the last state, if the PTU has a frame there.
     pub final_position_error: Option<f64>,
-    /// Largest distance between a prescribed vertex (the driven crease's facets) and the
-    /// PTU's frame: how exactly the drive reproduces the PTU's actuation.
+    /// Largest distance between a prescribed vertex (of the facets the actuation moves or
+    /// fixes) and the PTU's frame: how exactly the drive reproduces the PTU's actuation.
     pub drive_error: f64,
     /// Largest distance between the PTU's frame at t_start and the flat layout the
     /// simulation starts from (the PTU's own rounding at the flat, singular state).
@@ -695,13 +991,17 @@ fn compare(
         });
     }
     let widened_states = states.iter().filter(|s| s.error_bound.is_some()).count();
+    let driven_edges: Vec<usize> = drive.creases().iter().map(|c| c.edge).collect();
     let final_position_error = states
         .last()
         .filter(|s| s.j > 0)
         .and_then(|s| s.position_error);
     CrossvalReport {
-        driven_edge: drive.edge,
-        angle_source: drive.source.clone(),
+        // `g0_input` refused an actuation without creases, so there is a first.
+        driven_edge: driven_edges.first().copied().unwrap_or_default(),
+        driven_edges,
+        fixed_face: drive.fixed_face(),
+        angle_source: drive.source(),
         steps: input.steps,
         t_start: input.t_start,
         t_end: input.t_end,
@@ -755,7 +1055,9 @@ fn error_bound(input: &SimInput, x: &[[f64; 3]]) -> f64 {
 
 /// Cross-validate a design of `model` (full variable vector, ±1 modes) over `[0, t_max]`
 /// in `steps` steps: the PTU's frames are computed at exactly the simulator's t_j, and the
-/// driven crease follows the task's drive expression (exact at every t).
+/// driven creases follow the task's drive expressions (exact at every t), by the model's
+/// actuation ([`design_drive`]: one crease folded symmetrically, or a fixed central
+/// facet).
 pub fn crossval_design(
     model: &Model,
     full_vars: Vec<f64>,
@@ -779,17 +1081,40 @@ pub fn crossval_design(
     )
 }
 
-/// The G0 drive of a model: its actuated crease (creases come first among a design
-/// pattern's edges, in plan order) with the task's drive expression.
+/// The G0 drive of a model, as `model::geometry::fold` applies the plan's actuation:
+/// without a fixed facet, the symmetric fold of its actuated crease; with one (a driven
+/// central facet), that facet fixed and every driven crease turning its other facet.
+/// Creases come first among a design pattern's edges, in plan order, and the pattern's
+/// facets are the plan's polygons with at least three corners.
 pub fn design_drive(model: &Model) -> Result<G0Drive, CrossvalError> {
-    let k = model.plan.actuation.crease;
-    let expr = model.plan.creases[k].drive.clone().ok_or_else(|| {
-        CrossvalError::Angle(format!("the model's actuated crease {k} has no drive"))
-    })?;
-    Ok(G0Drive {
-        edge: k,
-        source: expr.to_string(),
-        angle: Arc::new(move |t| expr.eval(&t)),
+    let plan = &model.plan;
+    let crease = |k: usize| {
+        let expr = plan.creases[k].drive.clone().ok_or_else(|| {
+            CrossvalError::Angle(format!("the model's actuated crease {k} has no drive"))
+        })?;
+        Ok::<_, CrossvalError>(DrivenCrease {
+            edge: k,
+            source: expr.to_string(),
+            angle: Arc::new(move |t| expr.eval(&t)),
+        })
+    };
+    let Some(fixed) = plan.actuation.fixed else {
+        return Ok(G0Drive::Symmetric(crease(plan.actuation.crease)?));
+    };
+    let corners = |f: usize| plan.polygons.get(f).map_or(0, |(p, _)| p.len());
+    if corners(fixed) < 3 {
+        return Err(CrossvalError::Angle(format!(
+            "the model's fixed facet {fixed} is not a polygon of the pattern"
+        )));
+    }
+    Ok(G0Drive::Fixed {
+        face: (0..fixed).filter(|&f| corners(f) >= 3).count(),
+        creases: plan
+            .actuation
+            .driven
+            .iter()
+            .map(|&k| crease(k))
+            .collect::<Result<_, _>>()?,
     })
 }
 
@@ -812,8 +1137,8 @@ pub struct SimulationVerdict {
 }
 
 /// Both verifications of a cyclic design (r2′): the dense PTU sweep
-/// ([`crate::check::cycle`]) and the bar-and-hinge simulation driven by G0's crease, which
-/// decides.
+/// ([`crate::check::cycle`]) and the bar-and-hinge simulation driven by G0's actuation,
+/// which decides.
 #[derive(Clone, Debug, Serialize, serde::Deserialize)]
 pub struct CyclicVerdict {
     /// The sweep: compatibility residual and position disagreement.
