@@ -409,3 +409,163 @@ fn driven_polygons_that_cannot_work_are_refused_naming_the_field() {
         "exactly one open sector",
     );
 }
+
+const CHAIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/mirror_chair.toml");
+const CHAIR_PLAIN: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/tests/data/mirror_chair_plain.toml"
+);
+
+/// The cycle sweeps of `seq` on `task` at `draws` random interior geometries, every mode
+/// assignment: only those where the r2′ crease really folds (> 0.05 rad) on some checked
+/// state, where the sweep has something to say.
+fn folding_cycles(task: &str, seq: &str, draws: u64) -> Vec<foldsynth::check::cycle::CycleReport> {
+    use foldsynth::model::Model;
+    use foldsynth::model::numeric::{Evaluated, sample_times};
+    let task = Task::load(task).unwrap();
+    let graph = CreaseGraph::from_sequence(&task, seq).unwrap();
+    assert!(graph.is_cyclic_pattern(), "{seq}");
+    let m = Model::new(&graph, &task, 0).unwrap();
+    let ts = sample_times(m.t_max, 91);
+    let n = m.plan.n_modes;
+    let mut out = Vec::new();
+    let mut s = 46;
+    for _ in 0..draws {
+        let x: Vec<f64> = m
+            .free
+            .iter()
+            .map(|&i| {
+                let (lo, hi) = m.var_bounds(i);
+                lo + (0.2 + 0.6 * lcg(&mut s)) * (hi - lo)
+            })
+            .collect();
+        for bits in 0..1u32 << n {
+            let modes = (0..n)
+                .map(|k| if bits >> k & 1 == 1 { -1.0 } else { 1.0 })
+                .collect();
+            let d = Evaluated::new(&m.plan, m.full_vars(&x), modes);
+            let r = foldsynth::check::cycle::verify_cycles(&d, &ts, 1e-12);
+            if r.checked_states > 0 && r.shared_fold_max > 0.05 {
+                out.push(r);
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn a_crease_across_the_mirror_axis_is_overconstrained_yet_compatible() {
+    // Sec. 4.3.3: the chair's crease v5–v5' crosses the axis; both ends' PTU give its
+    // dihedral angle, and by symmetry they agree (ρ_{5,5'} = ρ_{5',5}) at every geometry
+    // and every state, so the overconstrained pattern folds rigidly. Here v4 (a successor
+    // of G0's end a) is extended and a successor of it joins its mirror image's on the
+    // axis; in the second graph a second crease crosses the axis further out.
+    for seq in ["1, 4, (10, 15)'", "1, 4, (5, 12), (9, 13)'"] {
+        let rs = folding_cycles(CHAIR, seq, 60);
+        assert!(rs.len() >= 5, "{seq}: {} folding draws", rs.len());
+        for r in &rs {
+            assert!(r.compatibility_max <= 1e-9, "{seq}: {r:?}");
+            assert!(r.position_max <= 1e-9, "{seq}: {r:?}");
+        }
+    }
+    // The same pattern without the symmetry (a, b, v4 and its mirror image v9 extended by
+    // variables of their own): the thesis's "if any of the vertices were to change location, any deviation
+    // of ρ_d would lead to a non-rigid motion". Almost no geometry is compatible.
+    let rs = folding_cycles(CHAIR_PLAIN, "1, 2, 4, 9, (10, 15)'", 60);
+    assert!(rs.len() >= 5, "{} folding draws", rs.len());
+    let compatible = rs.iter().filter(|r| r.compatibility_max <= 1e-6).count();
+    assert!(
+        compatible * 10 <= rs.len(),
+        "{compatible} of {} asymmetric draws compatible",
+        rs.len()
+    );
+}
+
+#[test]
+fn a_mirrored_pattern_folds_into_its_own_mirror_image() {
+    // The chair's G0 with mirror_axis x = 0: every image of a vertex lies, flat and folded
+    // at every rigid state, at its representative's mirror image (x → −x; the driven
+    // crease crosses the axis at a right angle), with the seat fixed and with the crease
+    // folded symmetrically (±ρ/2: the split crease's two halves turn the same two facets).
+    let text = std::fs::read_to_string(CHAIR).unwrap();
+    let symmetric = text.replace("[initial_graph]\nfixed = \"seat\"\n", "");
+    assert_ne!(symmetric, text);
+    let fixed = Task::load(CHAIR).unwrap();
+    let folded_both_ways = Task::from_toml_str(&symmetric, "mirror_chair.toml").unwrap();
+    for (task, seq) in ["1", "1, 4", "1, 4, (10, 15)'"]
+        .into_iter()
+        .flat_map(|s| [(&fixed, s), (&folded_both_ways, s)])
+    {
+        let graph = CreaseGraph::from_sequence(task, seq).unwrap();
+        let m = foldsynth::model::Model::new(&graph, task, 0).unwrap();
+        let plan = &m.plan;
+        assert_eq!(plan.isometries.len(), 2, "{seq}");
+        // Both facets of the one driven crease bound it; the one the task names stays.
+        let stays = plan.actuation.fixed.map(|f| plan.facet_names[f].as_str());
+        let named = matches!(
+            task.initial.actuation,
+            foldsynth::task::G0Actuation::Fixed { .. }
+        )
+        .then_some("seat");
+        assert_eq!(stays, named, "{seq}");
+        let mut checked = 0;
+        let mut s = 37;
+        for _ in 1..40 {
+            let x: Vec<f64> = m
+                .free
+                .iter()
+                .map(|&i| {
+                    let (lo, hi) = m.var_bounds(i);
+                    lo + (0.2 + 0.6 * lcg(&mut s)) * (hi - lo)
+                })
+                .collect();
+            let flat = geometry::flat(plan, &m.full_vars(&x));
+            for (i, &(rep, _)) in plan.orbit.iter().enumerate() {
+                let (p, q) = (flat.pos[rep], flat.pos[i]);
+                let mirrored = (p[0] + q[0]).abs() < 1e-12 && (p[1] - q[1]).abs() < 1e-12;
+                let same = (p[0] - q[0]).abs() < 1e-12 && (p[1] - q[1]).abs() < 1e-12;
+                assert!(mirrored || same, "{seq}: flat v{} vs v{}", i + 1, rep + 1);
+            }
+            for bits in 0..1u32 << plan.n_modes {
+                let modes: Vec<f64> = (0..plan.n_modes)
+                    .map(|k| if bits >> k & 1 == 1 { -1.0 } else { 1.0 })
+                    .collect();
+                for step in 1..=6 {
+                    let t = step as f64 * 0.25;
+                    let folded = geometry::fold(plan, &flat, &modes, &t);
+                    if folded
+                        .states
+                        .iter()
+                        .flatten()
+                        .any(|s| s.margins.iter().any(|m| m.is_nan() || *m < 0.0))
+                    {
+                        continue;
+                    }
+                    checked += 1;
+                    for (i, &(rep, g)) in plan.orbit.iter().enumerate() {
+                        let a = geometry::position(plan, &flat, &folded, rep);
+                        let b = geometry::position(plan, &flat, &folded, i);
+                        let m = &plan.isometries[g].m;
+                        let image = [
+                            m[0][0] * a[0] + m[0][1] * a[1],
+                            m[1][0] * a[0] + m[1][1] * a[1],
+                            a[2],
+                        ];
+                        for k in 0..3 {
+                            assert!(
+                                (image[k] - b[k]).abs() < 1e-9,
+                                "{seq} modes {modes:?}: v{} is not the image of v{} at t {t}: {b:?} vs {image:?}",
+                                i + 1,
+                                rep + 1
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            checked >= 6,
+            "{seq}: rigid at only {checked} sampled states"
+        );
+    }
+}

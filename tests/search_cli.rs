@@ -368,3 +368,57 @@ fn the_report_carries_the_most_robust_in_full_and_every_design_as_a_row() {
     assert!(!html.contains("designs in full (<code>--report-designs</code>)"));
     assert!(html.contains("\"rows\":["));
 }
+
+/// `--graph SEQ` searches only that meaningful graph (every mode assignment of it), takes
+/// the sequence in any spacing, keeps it in the run's settings (a resume with another
+/// graph is refused), and refuses a sequence that is not a meaningful graph of the search.
+#[test]
+fn graph_restricts_the_search_to_one_topology() {
+    let flasher = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/flasher_cuboid.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("one");
+    let o = out.to_str().unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["synthesize", flasher, "--out", o, "--no-export", "--json"];
+        args.extend_from_slice(extra);
+        foldsynth(&args)
+    };
+    let r = run(&["--graph", "1,9"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let s: Value = serde_json::from_slice(&r.stdout).unwrap();
+    // `1, 9` has two extended orbits: 2^2 mode assignments, one area candidate.
+    assert_eq!(s["graphs"].as_u64(), Some(1));
+    assert_eq!(s["alternatives"].as_u64(), Some(4));
+    let recs = records(&out);
+    assert_eq!(recs.len(), 4);
+    assert!(recs.values().all(|r| r["sequence"] == "1, 9"));
+    let settings: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("settings.json")).unwrap()).unwrap();
+    assert_eq!(settings["graphs"][0], "1,9");
+
+    let other = run(&["--graph", "1, 10", "--resume"]);
+    assert!(!other.status.success());
+    let err = String::from_utf8_lossy(&other.stderr);
+    assert!(err.contains("graphs"), "{err}");
+
+    let fresh = dir.path().join("bad");
+    for (seq, says) in [
+        ("1, (9, 20), 10", "not a meaningful graph"),
+        ("1, 9, 9", "not extendable"),
+        ("1, (2, 3)", "--graph \"1, (2, 3)\""),
+        ("1, 11, 23, (10, 21)", "more than N_max = 2"),
+    ] {
+        let r = foldsynth(&[
+            "synthesize",
+            flasher,
+            "--out",
+            fresh.to_str().unwrap(),
+            "--no-export",
+            "--graph",
+            seq,
+        ]);
+        assert!(!r.status.success(), "{seq} was accepted");
+        let err = String::from_utf8_lossy(&r.stderr);
+        assert!(err.contains(says), "{seq}: {err}");
+    }
+}

@@ -64,7 +64,7 @@ fn classes<'a>(
     records: &'a [AlternativeRecord],
     models: &mut BTreeMap<(usize, usize), (Model, CompiledModel)>,
 ) -> Classes<'a> {
-    let plan = foldsynth::search::plan(task, 3, Rules::default()).unwrap();
+    let plan = foldsynth::search::plan(task, 3, Rules::default(), &[]).unwrap();
     let mut classes: Classes = BTreeMap::new();
     for r in records {
         let (g, c) = (r.graph, r.candidate - 1);

@@ -411,3 +411,23 @@ fn an_area_term_alone_is_an_objective() {
     let a = o.area.unwrap();
     assert_eq!((a.kind, a.weight, a.at_least), (AreaKind::Flat, 1.0, 0.0));
 }
+
+/// The three gripping candidates of a graph are three problems only when the gripping
+/// vertex matters: a term names `tip`, or names the vertex extended last's successors in
+/// a task with copies (the arms may touch at the gripping vertex). `s1`–`s3` and `last`
+/// alone name the same vertices whichever successor grips.
+#[test]
+fn gripping_candidates_matter_only_for_the_tip_or_copies() {
+    let base = ALL.split("[objective]").next().unwrap();
+    let target = |v: &str| {
+        format!(
+            "[objective]\nthreshold = 1e-3\n[[objective.targets]]\nvertex = \"{v}\"\nt = \"pi/2\"\npoint = [0, 0, 1]\n"
+        )
+    };
+    let task = |extra: &str| Task::from_toml_str(&format!("{base}{extra}"), "g.toml").unwrap();
+    assert!(task(&target("tip")).uses_gripping_vertex());
+    assert!(!task(&target("s1")).uses_gripping_vertex());
+    assert!(!task(&target("last")).uses_gripping_vertex());
+    assert!(task(&format!("{}[copies]\nn = 2\n", target("s1"))).uses_gripping_vertex());
+    assert!(!task(&target("v1")).uses_gripping_vertex());
+}

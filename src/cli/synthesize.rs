@@ -1,5 +1,5 @@
 //! `foldsynth synthesize TASK [--out DIR] [--jobs N] [--starts K] [--seed S] [--resume]
-//! [--force] [--export N|all | --no-export] [--shard K/N]`: the whole method on a design task, or one shard of it.
+//! [--force] [--export N|all | --no-export] [--shard K/N] [--graph SEQ]...`: the whole method on a design task, or one shard of it.
 
 use crate::distribute;
 use crate::limits;
@@ -85,6 +85,11 @@ pub struct SynthesizeArgs {
     /// them, since a parent may be in another shard).
     #[arg(long)]
     pub no_warm_starts: bool,
+    /// Search only this graph (a rule sequence as `foldsynth enumerate` lists the
+    /// meaningful graphs, e.g. "1, (9, 20), 9"); repeat for several. Every mode assignment
+    /// of each is optimized; the others are not searched.
+    #[arg(long, value_name = "SEQ")]
+    pub graph: Vec<String>,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -130,6 +135,7 @@ pub fn run(args: SynthesizeArgs) -> Result<()> {
         },
         warm_starts: !args.no_warm_starts,
         on_progress: None,
+        graphs: args.graph,
     };
     if let Some(spec) = args.shard {
         // The text the task was read from, kept with the shard for the merge.

@@ -321,7 +321,7 @@ pub fn merge(dirs: &[PathBuf], opts: &MergeOptions) -> Result<Summary, Distribut
         search_opts.budget.alternatives = selection.alternatives;
     }
     let n_max = search::check_search(&task, &search_opts)?;
-    let plan = search::plan(&task, n_max, search_opts.rules)?;
+    let plan = search::plan(&task, n_max, search_opts.rules, &search_opts.graphs)?;
     let deal = deal(&plan, &searched(&plan, guided), shards[0].spec.count);
     // Every shard complete, every record in its place, before anything is written.
     let (failed, compile_s) = check_complete(&plan, &shards, &deal, &settings)?;
@@ -413,6 +413,7 @@ fn search_options(
         budget: search::Budget::default(),
         warm_starts: false,
         on_progress: None,
+        graphs: settings.graphs.clone(),
     })
 }
 

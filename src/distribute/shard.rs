@@ -78,7 +78,7 @@ pub fn run(
             "a shard's share must be the same on every machine: give a guided search in shards a budget of alternatives (--budget-alternatives), not of CPU seconds",
         ));
     }
-    let plan = search::plan(task, n_max, opts.rules)?;
+    let plan = search::plan(task, n_max, opts.rules, &opts.graphs)?;
     let guided = (opts.strategy == search::Strategy::Guided).then_some(search::Selection {
         alternatives: opts.budget.alternatives,
     });

@@ -11,8 +11,9 @@
 //! and the sink closes a real facet:
 //! - each has exactly one predecessor (p1 of c1, p2 of c2);
 //! - neither is in G0 (a G0 vertex has fixed coordinates, not the midpoint);
-//! - p1 and p2 are not joined by a crease, nor by an earlier sink's straight crease (the
-//!   shared facet would collapse onto the segment, or two creases would coincide);
+//! - p1 and p2 are not joined by a crease, nor by an earlier sink's straight crease, nor
+//!   by a driven G0 side split at its midpoint (the shared facet would collapse onto the
+//!   segment, or two creases would coincide, or the sink would sit on the side's source);
 //! - merging the two far-side facets does not put one facet on both sides of a crease.
 //!
 //! **Transformation** — a new sink v′ (type ∅, no outgoing creases, predecessors p1, p2)
@@ -72,14 +73,17 @@ impl CreaseGraph {
         }
         let (e1, e2) = (self.cr(a.preds[0]), self.cr(b.preds[0]));
         let (p1, p2) = (e1.tail, e2.tail);
-        // A crease p1–p2, or an earlier sink's straight crease between them (a second one
-        // would lie on top of it).
-        if self
-            .creases()
-            .any(|c| (c.tail == p1 && c.head == p2) || (c.tail == p2 && c.head == p1))
-            || self.sinks().any(|v| {
-                v.sink_between
-                    .is_some_and(|[a, b]| (a == p1 && b == p2) || (a == p2 && b == p1))
+        // A crease p1–p2, an earlier sink's straight crease between them, or a driven G0
+        // side between them split at its midpoint (the chair's seat crease): a second
+        // crease would lie on top of it, and the sink on the side's midpoint source.
+        let pair = |a: Vid, b: Vid| (a == p1 && b == p2) || (a == p2 && b == p1);
+        if self.creases().any(|c| pair(c.tail, c.head))
+            || self
+                .sinks()
+                .any(|v| v.sink_between.is_some_and(|[a, b]| pair(a, b)))
+            || self.init.split.iter().any(|s| {
+                let [a, b] = s.ends;
+                pair(Vid(a as u32), Vid(b as u32))
             })
         {
             return Err(NoR2p::Joined(p1, p2));

@@ -43,15 +43,8 @@ pub fn interface(
                 .internal
                 .iter()
                 .zip(&plan.modes)
-                .filter(|(_, (slot, _))| *slot == k)
-                .map(|(&v, (_, sign))| {
-                    let name = plan.vertices[v].name;
-                    if *sign < 0.0 {
-                        format!("-v{name}")
-                    } else {
-                        format!("v{name}")
-                    }
-                })
+                .filter(|(_, slot)| **slot == k)
+                .map(|(&v, _)| format!("v{}", plan.vertices[v].name))
                 .collect();
             Parameter {
                 name: format!("M{}", k + 1),

@@ -268,19 +268,15 @@ pub struct Plan {
     /// placed vertex after its parent and reference).
     pub position_order: Vec<usize>,
     /// For every internal vertex (as in [`Plan::internal`]): the mode parameter it folds
-    /// by and its sign (an image under a reflection folds by the opposite sign of the
-    /// mirrored vertex triangle).
-    pub modes: Vec<(usize, f64)>,
+    /// by. An image folds by its representative's mode, under a reflection too: each
+    /// vertex's PTU reads its own creases counter-clockwise, so the mirrored vertex with
+    /// the same mode is the mirror image of the folded representative (the paper's normal
+    /// is kept by a reflection in its plane; `tests/pattern_families.rs` checks it).
+    pub modes: Vec<usize>,
     /// Number of mode parameters: one per extended orbit (per internal vertex without a
     /// symmetry, or with [`Plan::with_vertex_modes`]).
     pub n_modes: usize,
 }
-
-/// The mode sign of a vertex mirrored by a reflection relative to its source: the
-/// reflection reverses the counter-clockwise order of its creases (u2 and u3 trade
-/// places), which mirrors the vertex triangle, and the same folded shape is the other
-/// solution of the PTU.
-pub const MIRROR_MODE_SIGN: f64 = -1.0;
 
 impl Plan {
     /// Build the plan of `graph`.
@@ -301,22 +297,13 @@ impl Plan {
     /// The mode of every internal vertex (in the order of [`Plan::internal`]) from the
     /// mode parameters.
     pub fn vertex_modes<S: crate::kinematics::Scalar>(&self, modes: &[S]) -> Vec<S> {
-        self.modes
-            .iter()
-            .map(|&(k, sign)| {
-                if sign == 1.0 {
-                    modes[k].clone()
-                } else {
-                    modes[k].clone() * sign
-                }
-            })
-            .collect()
+        self.modes.iter().map(|&k| modes[k].clone()).collect()
     }
 
     /// The same plan with one mode parameter per internal vertex (images no longer fold
     /// like their representative: the star pattern's 2^8 assignments, Sec. 4.3.2).
     pub fn with_vertex_modes(mut self) -> Plan {
-        self.modes = (0..self.internal.len()).map(|k| (k, 1.0)).collect();
+        self.modes = (0..self.internal.len()).collect();
         self.n_modes = self.internal.len();
         self
     }
@@ -462,18 +449,17 @@ impl Builder {
         })
     }
 
-    /// Every internal vertex's mode parameter and sign.
-    fn modes(&self, graph: &CreaseGraph) -> Result<(Vec<(usize, f64)>, usize), PlanError> {
+    /// Every internal vertex's mode parameter.
+    fn modes(&self, graph: &CreaseGraph) -> Result<(Vec<usize>, usize), PlanError> {
         let mut out = Vec::new();
         let mut n = 0;
         for &v in graph.extension_order() {
-            let (slot, g) = graph.mode_slot(v).ok_or_else(|| {
+            let (slot, _) = graph.mode_slot(v).ok_or_else(|| {
                 PlanError(format!(
                     "the extended vertex {v:?} has no mode of its orbit"
                 ))
             })?;
-            let reflects = graph.group().is_some_and(|gr| gr.reflects(g));
-            out.push((slot, if reflects { MIRROR_MODE_SIGN } else { 1.0 }));
+            out.push(slot);
             n = n.max(slot + 1);
         }
         Ok((out, n))
@@ -567,28 +553,44 @@ impl Builder {
         };
         let fixed = match graph.initial_graph().actuation {
             crate::task::G0Actuation::Split { .. } => None,
-            crate::task::G0Actuation::Fixed { .. } => {
-                // The facet every driven crease bounds (facet ids may have moved since G0).
+            crate::task::G0Actuation::Fixed { facet } => {
+                // The facet every driven crease bounds (facet ids may have moved since G0,
+                // names do not). Both of a single driven side's facets bound it: then the
+                // one the task names.
                 let c = &creases[first];
-                [c.left, c.right]
+                let bounding: Vec<usize> = [c.left, c.right]
                     .into_iter()
-                    .find(|f| {
+                    .filter(|f| {
                         driven
                             .iter()
                             .all(|&i| creases[i].left == *f || creases[i].right == *f)
                     })
-                    .map(Some)
-                    .ok_or_else(|| {
-                        PlanError("the driven creases no longer bound one facet".into())
-                    })?
+                    .collect();
+                let named = &graph.initial_graph().facets[facet];
+                match bounding.as_slice() {
+                    [f] => Some(*f),
+                    [..] => bounding
+                        .iter()
+                        .copied()
+                        .find(|&f| graph.facet_name(crate::grammar::FacetId(f as u32)) == named)
+                        .map(Some)
+                        .ok_or_else(|| {
+                            PlanError(format!(
+                                "the driven creases no longer bound the fixed facet \"{named}\""
+                            ))
+                        })?,
+                }
             }
         };
         if fixed.is_none() && driven.len() > 1 {
             let c = &creases[first];
-            if driven
-                .iter()
-                .any(|&i| (creases[i].left, creases[i].right) != (c.left, c.right))
-            {
+            // A side split at its midpoint has halves pointing away from each other: the
+            // same two facets, left and right traded.
+            let between = |i: usize| {
+                let (l, r) = (creases[i].left, creases[i].right);
+                (l, r) == (c.left, c.right) || (r, l) == (c.left, c.right)
+            };
+            if !driven.iter().all(|&i| between(i)) {
                 return Err(PlanError(
                     "driven creases folded symmetrically must lie between the same two facets"
                         .into(),

@@ -201,6 +201,8 @@ fn build_design(
         "obstacle_free": rec.obstacle_free,
         "robustness": rec.robustness,
         "requirements": rec.requirements,
+        "cycle": rec.cycle,
+        "simulation": rec.simulation,
         "fabrication": thick.as_ref().map(|t| &t.doc),
         "rank": rank,
         // The motion once: positions to ten digits, fold angles read back (issue 35).

@@ -192,6 +192,7 @@ fn optimized_record(
         optimize_ms,
         check_ms: 0.0,
         cycle: None,
+        simulation: None,
         requirements: None,
         fabrication: None,
     }
@@ -282,6 +283,24 @@ fn judge(
         .filter(|_| task.fabrication.is_some() && rec.passes_checks())
     {
         rec.fabrication = Some(measure_thick(task, model, &arm, pat));
+    }
+    // Several drives (a central facet): the bar-and-hinge simulation cross-checks the
+    // PTU's motion of a design that passed everything else (0.5-2 s a design). The PTU is
+    // exact for an acyclic pattern, so a disagreement is a bug of one of the two.
+    if model.plan.actuation.fixed.is_some() && model.plan.sinks.is_empty() && rec.passes_checks() {
+        match crate::simulate::crossval::simulate_design(model, &design.vars, &design.modes) {
+            Ok(v) => {
+                if !v.agrees {
+                    eprintln!(
+                        "BUG: the bar-and-hinge simulation disagrees with the PTU for {} (graph {}): Γ {:e}, largest distance {:e}",
+                        rec.key, rec.sequence, v.gamma, v.max_position_error
+                    );
+                    rec.verification_failed = Some(true);
+                }
+                rec.simulation = Some(v);
+            }
+            Err(e) => eprintln!("warning: {}: the simulation could not run: {e}", rec.key),
+        }
     }
     // Margins are a design's: measured only where every check passed (with
     // `--post-check-only` most target-meeting alternatives fail one, and measuring them was

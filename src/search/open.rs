@@ -30,6 +30,7 @@ pub fn settings(
                 alternatives: opts.budget.alternatives,
             },
         ),
+        graphs: opts.graphs.clone(),
     }
 }
 

@@ -68,6 +68,10 @@ pub struct SearchOptions {
     /// Told of every step of the run's progress, and able to stop it (the Python
     /// package's progress callback and Ctrl-C); `None` for the CLI.
     pub on_progress: Option<ProgressHook>,
+    /// Search only these graphs (rule sequences, as `foldsynth enumerate` names the
+    /// meaningful graphs; `synthesize --graph`): every alternative of each; empty: every
+    /// meaningful graph up to N_max.
+    pub graphs: Vec<String>,
 }
 
 impl Default for SearchOptions {
@@ -92,6 +96,7 @@ impl Default for SearchOptions {
             budget: Budget::default(),
             warm_starts: true,
             on_progress: None,
+            graphs: Vec::new(),
         }
     }
 }

@@ -68,6 +68,10 @@ pub struct RunSettings {
     /// run, so a whole run's records serve either strategy).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub guided: Option<super::strategy::Selection>,
+    /// The graphs a run restricted to some (`synthesize --graph`), as given; absent: every
+    /// meaningful graph.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub graphs: Vec<String>,
 }
 
 /// Shard K of N (1 ≤ K ≤ N), written `K/N`.

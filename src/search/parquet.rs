@@ -422,6 +422,13 @@ const TAIL: &[Column] = &[
         "JSON: cyclic graphs' compatibility and simulation verdict",
     ),
     col(
+        "simulation",
+        &["simulation"],
+        Json,
+        "",
+        "JSON: designs with a driven central facet: the bar-and-hinge simulation against the PTU",
+    ),
+    col(
         "requirements",
         &["requirements"],
         Json,

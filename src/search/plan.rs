@@ -161,11 +161,29 @@ impl Plan {
             }
         });
         let candidates = if task.uses_gripping_vertex() { 3 } else { 1 };
-        let mut units = Vec::with_capacity(graphs.len() * candidates);
+        let mut plan = Plan {
+            n_max,
+            cyclic_graphs,
+            candidates,
+            graphs,
+            units: Vec::new(),
+            alternatives: 0,
+            tree,
+            generated: streamed.generated,
+            enumerate_s: t0.elapsed().as_secs_f64(),
+            by_sequence: Vec::new(),
+        };
+        plan.lay_out_units();
+        plan
+    }
+
+    /// The units of `self.graphs` in record order, their numbering and the sequence index.
+    fn lay_out_units(&mut self) {
+        let mut units = Vec::with_capacity(self.graphs.len() * self.candidates);
         let mut first = 0u64;
-        for (g, pg) in graphs.iter().enumerate() {
+        for (g, pg) in self.graphs.iter().enumerate() {
             let count = 1u64 << pg.n;
-            for candidate in 0..candidates {
+            for candidate in 0..self.candidates {
                 units.push(Unit {
                     graph: g,
                     candidate,
@@ -176,24 +194,72 @@ impl Plan {
                 first += count;
             }
         }
-        let mut by_sequence: Vec<(u64, usize)> = graphs
+        let mut by_sequence: Vec<(u64, usize)> = self
+            .graphs
             .iter()
             .enumerate()
             .map(|(i, g)| (text_hash(&g.sequence), i))
             .collect();
         by_sequence.sort_unstable();
-        Plan {
-            n_max,
-            cyclic_graphs,
-            candidates,
-            graphs,
-            units,
-            alternatives: first,
-            tree,
-            generated: streamed.generated,
-            enumerate_s: t0.elapsed().as_secs_f64(),
-            by_sequence,
+        self.units = units;
+        self.alternatives = first;
+        self.by_sequence = by_sequence;
+    }
+
+    /// Keep only the graphs `sequences` name (`synthesize --graph`): each must parse on
+    /// `task` and be one of the plan's meaningful graphs, written in any spacing. The
+    /// enumeration's other graphs are dropped with their units; a kept graph whose parent
+    /// is dropped has none (no warm start from it).
+    pub fn restrict(&mut self, task: &Task, sequences: &[String]) -> Result<(), SearchError> {
+        let err = |message: String| SearchError::Task {
+            task: task.name.clone(),
+            message,
+        };
+        let mut keep = vec![false; self.graphs.len()];
+        for s in sequences {
+            let shown = crate::text::excerpt(s, 120);
+            let graph = CreaseGraph::from_sequence(task, s)
+                .map_err(|e| err(format!("--graph \"{shown}\": {e}")))?;
+            let seq = graph.sequence();
+            let g = self.find(&seq).ok_or_else(|| {
+                let why = if graph.internal_count() > self.n_max {
+                    format!(
+                        "it has {} internal vertices, more than N_max = {} (--n-max)",
+                        graph.internal_count(),
+                        self.n_max
+                    )
+                } else {
+                    "it is isomorphic to, or the mirror image of, a graph generated before it, or invalid; `foldsynth enumerate TASK --n-max N` lists the meaningful graphs by the sequences to give here".into()
+                };
+                err(format!("--graph \"{shown}\" is not a meaningful graph of this search: {why}"))
+            })?;
+            keep[g] = true;
         }
+        let mut new_index = vec![usize::MAX; self.graphs.len()];
+        let mut kept = Vec::new();
+        for (g, pg) in std::mem::take(&mut self.graphs).into_iter().enumerate() {
+            if keep[g] {
+                new_index[g] = kept.len();
+                kept.push(pg);
+            }
+        }
+        for pg in &mut kept {
+            pg.parent = pg.parent.map(|p| new_index[p]).filter(|&p| p != usize::MAX);
+        }
+        self.graphs = kept;
+        self.lay_out_units();
+        Ok(())
+    }
+
+    /// The index of the meaningful graph with exactly this sequence.
+    fn find(&self, sequence: &str) -> Option<usize> {
+        let h = text_hash(sequence);
+        let from = self.by_sequence.partition_point(|&(k, _)| k < h);
+        self.by_sequence[from..]
+            .iter()
+            .take_while(|&&(k, _)| k == h)
+            .map(|&(_, i)| i)
+            .find(|&i| self.graphs[i].sequence == sequence)
     }
 
     /// The crease graph of meaningful graph `g`, rebuilt from its rule sequence.
@@ -220,13 +286,7 @@ impl Plan {
     pub fn locate(&self, key: &str) -> Option<Place> {
         let mut parts = key.rsplitn(3, '|');
         let (modes, candidate, sequence) = (parts.next()?, parts.next()?, parts.next()?);
-        let h = text_hash(sequence);
-        let from = self.by_sequence.partition_point(|&(k, _)| k < h);
-        let g = self.by_sequence[from..]
-            .iter()
-            .take_while(|&&(k, _)| k == h)
-            .map(|&(_, i)| i)
-            .find(|&i| self.graphs[i].sequence == sequence)?;
+        let g = self.find(sequence)?;
         let candidate: usize = candidate.parse().ok()?;
         if !(1..=self.candidates).contains(&candidate) {
             return None;
@@ -257,9 +317,18 @@ impl Plan {
     }
 }
 
-/// The plan of `task`'s search at `n_max`; an error when there is nothing to search.
-pub fn plan(task: &Task, n_max: usize, rules: Rules) -> Result<Plan, SearchError> {
-    let plan = Plan::with_rules(task, n_max, rules);
+/// The plan of `task`'s search at `n_max`, restricted to the graphs `graphs` names when
+/// it names any; an error when there is nothing to search.
+pub fn plan(
+    task: &Task,
+    n_max: usize,
+    rules: Rules,
+    graphs: &[String],
+) -> Result<Plan, SearchError> {
+    let mut plan = Plan::with_rules(task, n_max, rules);
+    if !graphs.is_empty() && !plan.graphs.is_empty() {
+        plan.restrict(task, graphs)?;
+    }
     if plan.graphs.is_empty() {
         return Err(SearchError::Task {
             task: task.name.clone(),

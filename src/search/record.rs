@@ -84,6 +84,10 @@ pub struct AlternativeRecord {
     /// sweep and the bar-and-hinge simulation, which decide whether the design folds.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cycle: Option<crate::simulate::crossval::CyclicVerdict>,
+    /// For acyclic designs with a driven central facet (several drives) that pass every
+    /// check: the bar-and-hinge simulation driven the same way, against the PTU's motion.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<crate::simulate::crossval::SimulationVerdict>,
     /// For designs that meet the target: the task's requirements, obstacles, copies,
     /// targets and area judged again on the dense sweep by `check::requirements` (issue 31).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -24,7 +24,7 @@ pub fn run(task: &Task, opts: &SearchOptions) -> Result<Summary, SearchError> {
     let n_max = check_search(task, opts)?;
     let progress = Progress::new(opts.progress).with_hook(opts.on_progress.clone());
     progress.phase("enumerate graphs", "graphs", None);
-    let plan = plan(task, n_max, opts.rules)?;
+    let plan = plan(task, n_max, opts.rules, &opts.graphs)?;
     progress.inc(plan.graphs.len() as u64);
     progress.finish_phase_with(&format!(
         "{} generated, {} meaningful",

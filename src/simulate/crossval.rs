@@ -1173,25 +1173,37 @@ pub fn verify_cyclic(
     if !v.sweep.passes(CYCLE_TOL) {
         return v;
     }
-    match crossval_design(
+    match simulate_design(model, full_vars, modes) {
+        Ok(s) => {
+            v.passes = s.agrees;
+            v.simulation = Some(s);
+        }
+        Err(e) => v.error = Some(e.to_string()),
+    }
+    v
+}
+
+/// The bar-and-hinge simulation of a design of `model` (full variables, ±1 modes) over
+/// [`CYCLIC_STEPS`] steps of its motion, driven as its task drives it, against the PTU's
+/// states: the verdict a cyclic design's folding rests on, and for an acyclic design with
+/// a driven central facet the independent check of its several drives.
+pub fn simulate_design(
+    model: &Model,
+    full_vars: &[f64],
+    modes: &[f64],
+) -> Result<SimulationVerdict, CrossvalError> {
+    let r = crossval_design(
         model,
         full_vars.to_vec(),
         modes.to_vec(),
         CYCLIC_STEPS,
         &CrossvalOptions::default(),
-    ) {
-        Ok(r) => {
-            let agrees = r.agrees(GAMMA_TOL, POSITION_TOL);
-            v.simulation = Some(SimulationVerdict {
-                steps: r.steps,
-                gamma: r.gamma,
-                max_delta: r.max_delta,
-                max_position_error: r.max_position_error,
-                agrees,
-            });
-            v.passes = agrees;
-        }
-        Err(e) => v.error = Some(e.to_string()),
-    }
-    v
+    )?;
+    Ok(SimulationVerdict {
+        steps: r.steps,
+        gamma: r.gamma,
+        max_delta: r.max_delta,
+        max_position_error: r.max_position_error,
+        agrees: r.agrees(GAMMA_TOL, POSITION_TOL),
+    })
 }

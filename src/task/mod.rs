@@ -138,27 +138,32 @@ pub struct Task {
 }
 
 impl Task {
-    /// Whether some term names a vertex relative to the gripping vertex (`tip`, `s1`–`s3`,
-    /// `last`: a target, an orientation or a fold limit). When none does, the three
-    /// gripping candidates of a graph are one and the same problem, and the search
-    /// optimizes one.
+    /// Whether the gripping candidate changes the problem: some term names `tip` (a
+    /// target, an orientation or a fold limit), or names `s1`–`s3` or `last` in a task with
+    /// copies (there the gripping vertex is the one the arms may touch at, exempt from
+    /// their clearance). When neither, the three gripping candidates of a graph are one
+    /// and the same problem (`s1`–`s3` and `last` are the vertex extended last's, whichever
+    /// successor grips), and the search optimizes one.
     pub fn uses_gripping_vertex(&self) -> bool {
-        let relative = |v: &terms::VertexRef| !matches!(v, terms::VertexRef::Initial { .. });
         let targets = self.objective.iter().flat_map(|o| &o.targets);
-        targets.map(|t| &t.vertex).any(relative)
-            || self
-                .requirements
-                .orientations
-                .iter()
-                .any(|o| relative(&o.vertex))
-            || self
-                .requirements
-                .fold_limits
-                .iter()
-                .any(|l| match &l.crease {
-                    terms::CreaseRef::Into(v) => relative(v),
-                    terms::CreaseRef::Initial { .. } => false,
-                })
+        let mut named = targets
+            .map(|t| &t.vertex)
+            .chain(self.requirements.orientations.iter().map(|o| &o.vertex))
+            .chain(
+                self.requirements
+                    .fold_limits
+                    .iter()
+                    .filter_map(|l| match &l.crease {
+                        terms::CreaseRef::Into(v) => Some(v),
+                        terms::CreaseRef::Initial { .. } => None,
+                    }),
+            );
+        let copies = self.scene.copies.n >= 2;
+        named.any(|v| match v {
+            terms::VertexRef::Tip => true,
+            terms::VertexRef::Initial { .. } => false,
+            terms::VertexRef::Successor(_) | terms::VertexRef::Last => copies,
+        })
     }
 }
 
