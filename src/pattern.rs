@@ -55,6 +55,13 @@ pub struct Pattern {
 }
 
 impl Pattern {
+    /// The indices of the edges marked as driven creases, in edge order.
+    pub fn driven_edges(&self) -> Vec<usize> {
+        (0..self.edges.len())
+            .filter(|&i| matches!(self.edges[i].kind, EdgeKind::Crease { driven: true }))
+            .collect()
+    }
+
     /// The flat state lifted to 3D (z = 0).
     pub fn flat_coords(&self) -> Vec<[f64; 3]> {
         self.vertices.iter().map(|p| [p[0], p[1], 0.0]).collect()

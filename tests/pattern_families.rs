@@ -10,6 +10,8 @@
 #![allow(clippy::needless_range_loop)] // coordinates by index read as the formulas
 
 mod common;
+#[path = "common/designs.rs"]
+mod designs;
 use common::{assert_gradients, smooth};
 use foldsynth::grammar::CreaseGraph;
 use foldsynth::model::geometry;
@@ -36,6 +38,64 @@ fn variables(plan: &Plan, seed: u64) -> Vec<f64> {
             _ => 0.6 + 0.5 * lcg(&mut s),
         })
         .collect()
+}
+
+/// Free variables of `m` strictly inside their bounds (20–80 % of each range).
+fn interior(m: &foldsynth::model::Model, s: &mut u64) -> Vec<f64> {
+    m.free
+        .iter()
+        .map(|&i| {
+            let (lo, hi) = m.var_bounds(i);
+            lo + (0.2 + 0.6 * lcg(s)) * (hi - lo)
+        })
+        .collect()
+}
+
+/// Every assignment of ±1 to `n` modes.
+fn mode_assignments(n: usize) -> impl Iterator<Item = Vec<f64>> {
+    (0..1u32 << n).map(move |bits| {
+        (0..n)
+            .map(|k| if bits >> k & 1 == 1 { -1.0 } else { 1.0 })
+            .collect()
+    })
+}
+
+/// Whether every vertex folds within its rigid range (Eq. 25) in `folded`: the PTU folds a
+/// vertex only there.
+fn rigid(folded: &geometry::Folded<f64>) -> bool {
+    !folded
+        .states
+        .iter()
+        .flatten()
+        .any(|s| s.margins.iter().any(|m| m.is_nan() || *m < 0.0))
+}
+
+/// Every image's 3D position is its representative's under the image's isometry (in the
+/// plane of the fixed facet, z kept), computed independently by the plan.
+fn assert_images(
+    plan: &Plan,
+    flat: &geometry::Flat<f64>,
+    folded: &geometry::Folded<f64>,
+    what: &str,
+) {
+    for (i, &(rep, g)) in plan.orbit.iter().enumerate() {
+        let a = geometry::position(plan, flat, folded, rep);
+        let b = geometry::position(plan, flat, folded, i);
+        let m = &plan.isometries[g].m;
+        let image = [
+            m[0][0] * a[0] + m[0][1] * a[1],
+            m[1][0] * a[0] + m[1][1] * a[1],
+            a[2],
+        ];
+        for k in 0..3 {
+            assert!(
+                (image[k] - b[k]).abs() < 1e-9,
+                "{what}: v{} is not the image of v{}: {b:?} vs {image:?}",
+                i + 1,
+                rep + 1
+            );
+        }
+    }
 }
 
 #[test]
@@ -80,13 +140,7 @@ fn flasher_layer_is_rotationally_symmetric_rigid_and_closed_at_every_t() {
             for step in 1..=6 {
                 let t = step as f64 * 0.25;
                 let folded = geometry::fold(&plan, &flat, &modes, &t);
-                // The PTU folds a vertex only within its rigid range (Eq. 25).
-                if folded
-                    .states
-                    .iter()
-                    .flatten()
-                    .any(|s| s.margins.iter().any(|m| m.is_nan() || *m < 0.0))
-                {
+                if !rigid(&folded) {
                     continue;
                 }
                 checked += 1;
@@ -102,24 +156,7 @@ fn flasher_layer_is_rotationally_symmetric_rigid_and_closed_at_every_t() {
                 }
                 // Symmetry: an image's 3D position is its representative's turned about z
                 // (the central facet, fixed, is centred on the origin).
-                for (i, &(rep, g)) in plan.orbit.iter().enumerate() {
-                    let a = geometry::position(&plan, &flat, &folded, rep);
-                    let b = geometry::position(&plan, &flat, &folded, i);
-                    let m = &plan.isometries[g].m;
-                    let turned = [
-                        m[0][0] * a[0] + m[0][1] * a[1],
-                        m[1][0] * a[0] + m[1][1] * a[1],
-                        a[2],
-                    ];
-                    for k in 0..3 {
-                        assert!(
-                            (turned[k] - b[k]).abs() < 1e-9,
-                            "{seq}: v{} is not the image of v{} at t {t}: {b:?} vs {turned:?}",
-                            i + 1,
-                            rep + 1
-                        );
-                    }
-                }
+                assert_images(&plan, &flat, &folded, &format!("{seq} at t {t}"));
                 // Every facet map is a rotation.
                 for r in &folded.rot {
                     for a in 0..3 {
@@ -296,22 +333,8 @@ fn one_mode_per_vertex_folds_each_image_by_its_own_choice() {
         plan.n_modes, 8,
         "four corners and four vertices of the first layer"
     );
-    // The design `foldsynth synthesize grammar/flasher_cuboid.toml --n-max 2` found for
-    // this graph (flat area 54.8), rigid over its motion.
-    let design = [
-        ("l_1,9", 2.0),
-        ("l_1,10", 2.0),
-        ("l_1,11", 0.1),
-        ("l_9,21", 2.0),
-        ("l_9,22", 2.0),
-        ("l_9,23", 2.0),
-        ("α_9", 1.5757459817734865),
-        ("α_10", 1.4621383502335963),
-        ("α_11", 0.1745329251994492),
-        ("α_21", 2.0177084022658),
-        ("α_22", 1.1011805368487178),
-        ("α_23", 2.040536276595077),
-    ];
+    // The 54.8 design of this graph, rigid over its motion.
+    let design = designs::FLASHER_1_9;
     let vars: Vec<f64> = plan
         .variables
         .iter()
@@ -427,22 +450,11 @@ fn folding_cycles(task: &str, seq: &str, draws: u64) -> Vec<foldsynth::check::cy
     assert!(graph.is_cyclic_pattern(), "{seq}");
     let m = Model::new(&graph, &task, 0).unwrap();
     let ts = sample_times(m.t_max, 91);
-    let n = m.plan.n_modes;
     let mut out = Vec::new();
     let mut s = 46;
     for _ in 0..draws {
-        let x: Vec<f64> = m
-            .free
-            .iter()
-            .map(|&i| {
-                let (lo, hi) = m.var_bounds(i);
-                lo + (0.2 + 0.6 * lcg(&mut s)) * (hi - lo)
-            })
-            .collect();
-        for bits in 0..1u32 << n {
-            let modes = (0..n)
-                .map(|k| if bits >> k & 1 == 1 { -1.0 } else { 1.0 })
-                .collect();
+        let x = interior(&m, &mut s);
+        for modes in mode_assignments(m.plan.n_modes) {
             let d = Evaluated::new(&m.plan, m.full_vars(&x), modes);
             let r = foldsynth::check::cycle::verify_cycles(&d, &ts, 1e-12);
             if r.checked_states > 0 && r.shared_fold_max > 0.05 {
@@ -511,55 +523,27 @@ fn a_mirrored_pattern_folds_into_its_own_mirror_image() {
         let mut checked = 0;
         let mut s = 37;
         for _ in 1..40 {
-            let x: Vec<f64> = m
-                .free
-                .iter()
-                .map(|&i| {
-                    let (lo, hi) = m.var_bounds(i);
-                    lo + (0.2 + 0.6 * lcg(&mut s)) * (hi - lo)
-                })
-                .collect();
-            let flat = geometry::flat(plan, &m.full_vars(&x));
+            let flat = geometry::flat(plan, &m.full_vars(&interior(&m, &mut s)));
             for (i, &(rep, _)) in plan.orbit.iter().enumerate() {
                 let (p, q) = (flat.pos[rep], flat.pos[i]);
                 let mirrored = (p[0] + q[0]).abs() < 1e-12 && (p[1] - q[1]).abs() < 1e-12;
                 let same = (p[0] - q[0]).abs() < 1e-12 && (p[1] - q[1]).abs() < 1e-12;
                 assert!(mirrored || same, "{seq}: flat v{} vs v{}", i + 1, rep + 1);
             }
-            for bits in 0..1u32 << plan.n_modes {
-                let modes: Vec<f64> = (0..plan.n_modes)
-                    .map(|k| if bits >> k & 1 == 1 { -1.0 } else { 1.0 })
-                    .collect();
+            for modes in mode_assignments(plan.n_modes) {
                 for step in 1..=6 {
                     let t = step as f64 * 0.25;
                     let folded = geometry::fold(plan, &flat, &modes, &t);
-                    if folded
-                        .states
-                        .iter()
-                        .flatten()
-                        .any(|s| s.margins.iter().any(|m| m.is_nan() || *m < 0.0))
-                    {
+                    if !rigid(&folded) {
                         continue;
                     }
                     checked += 1;
-                    for (i, &(rep, g)) in plan.orbit.iter().enumerate() {
-                        let a = geometry::position(plan, &flat, &folded, rep);
-                        let b = geometry::position(plan, &flat, &folded, i);
-                        let m = &plan.isometries[g].m;
-                        let image = [
-                            m[0][0] * a[0] + m[0][1] * a[1],
-                            m[1][0] * a[0] + m[1][1] * a[1],
-                            a[2],
-                        ];
-                        for k in 0..3 {
-                            assert!(
-                                (image[k] - b[k]).abs() < 1e-9,
-                                "{seq} modes {modes:?}: v{} is not the image of v{} at t {t}: {b:?} vs {image:?}",
-                                i + 1,
-                                rep + 1
-                            );
-                        }
-                    }
+                    assert_images(
+                        plan,
+                        &flat,
+                        &folded,
+                        &format!("{seq} modes {modes:?} at t {t}"),
+                    );
                 }
             }
         }

@@ -9,6 +9,9 @@
 //! reproduces the PTU's motion; and a side whose midpoint left the side's line (two halves
 //! turning one facet about two lines) is refused, not simulated.
 
+#[path = "common/designs.rs"]
+mod designs;
+use designs::FLASHER_1_9;
 use foldsynth::grammar::CreaseGraph;
 use foldsynth::model::Model;
 use foldsynth::model::numeric::{Evaluated, sample_times};
@@ -49,24 +52,6 @@ fn model(name: &str, graph: &str, design: &[(&str, f64)]) -> (Model, Vec<f64>) {
     let vars = model.full_vars(&free);
     (model, vars)
 }
-
-/// The flasher cuboid's design of graph "1, 9", modes up, up (flat area 54.8): the values
-/// `tests/pattern_families.rs` (per-vertex modes) uses, from `foldsynth synthesize
-/// grammar/flasher_cuboid.toml --n-max 2`.
-const FLASHER: [(&str, f64); 12] = [
-    ("l_1,9", 2.0),
-    ("l_1,10", 2.0),
-    ("l_1,11", 0.1),
-    ("l_9,21", 2.0),
-    ("l_9,22", 2.0),
-    ("l_9,23", 2.0),
-    ("α_9", 1.5757459817734865),
-    ("α_10", 1.4621383502335963),
-    ("α_11", 0.1745329251994492),
-    ("α_21", 2.0177084022658),
-    ("α_22", 1.1011805368487178),
-    ("α_23", 2.040536276595077),
-];
 
 /// The star's design of graph "1, (9, 20), 9, (10, 19), (16, 17)", modes up, up (flat area
 /// 34.41), printed by `foldsynth model grammar/star.toml --graph "1, (9, 20), 9, (10, 19),
@@ -135,7 +120,7 @@ fn agrees(name: &str, graph: &str, design: &[(&str, f64)]) {
 
 #[test]
 fn a_flasher_cuboid_design_agrees_with_the_ptu() {
-    agrees("flasher_cuboid", "1, 9", &FLASHER);
+    agrees("flasher_cuboid", "1, 9", &FLASHER_1_9);
 }
 
 #[test]
@@ -146,7 +131,7 @@ fn a_star_design_agrees_with_the_ptu() {
 /// The flasher design's pattern with its PTU frames, its drive, and the vertices that
 /// drive fixes or moves (the rest are free).
 fn flasher_pattern() -> (Model, foldsynth::pattern::Pattern, G0Drive, Vec<usize>) {
-    let (model, vars) = model("flasher_cuboid", "1, 9", &FLASHER);
+    let (model, vars) = model("flasher_cuboid", "1, 9", &FLASHER_1_9);
     let modes = vec![1.0; model.plan.n_modes];
     let design = Evaluated::new(&model.plan, vars, modes);
     let pattern = design.pattern(&sample_times(model.t_max, STEPS + 1));

@@ -296,13 +296,7 @@ pub enum G0Drive {
 impl G0Drive {
     /// The edges of `pattern` marked as driven creases (at least one).
     pub fn marked_edges(pattern: &Pattern) -> Result<Vec<usize>, CrossvalError> {
-        let driven: Vec<usize> = pattern
-            .edges
-            .iter()
-            .enumerate()
-            .filter(|(_, e)| matches!(e.kind, EdgeKind::Crease { driven: true }))
-            .map(|(i, _)| i)
-            .collect();
+        let driven = pattern.driven_edges();
         if driven.is_empty() {
             return Err(CrossvalError::NoDrivenCrease);
         }

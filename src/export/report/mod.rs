@@ -36,7 +36,7 @@ use super::plots::{DistributionPlot, TreeNode, distribution_svg, search_tree_svg
 use super::verify::VerifyReport;
 use super::{DesignMeta, ExportError, Files, Result, validate_meta, validate_pattern};
 use crate::check::triangulate::triangulate_faces;
-use crate::pattern::{EdgeKind, Pattern};
+use crate::pattern::Pattern;
 
 /// three.js (r187, MIT; see `vendor/three/`): the parts the page uses, one classic script
 /// defining the global `FoldsynthThree`.
@@ -222,13 +222,7 @@ pub fn geometry_json(p: &Pattern) -> Result<Value> {
         .map_err(|e| ExportError::invalid("pattern.faces", e.to_string()))?;
     let tris: Vec<usize> = tris.into_iter().flatten().flatten().collect();
     let assign: String = assignments(p).iter().map(|a| a.as_str()).collect();
-    let driven: Vec<usize> = p
-        .edges
-        .iter()
-        .enumerate()
-        .filter(|(_, e)| matches!(e.kind, EdgeKind::Crease { driven: true }))
-        .map(|(i, _)| i)
-        .collect();
+    let driven = p.driven_edges();
     let frames: Vec<Vec<f64>> = p
         .frames
         .iter()
