@@ -46,11 +46,7 @@ pub fn lock_dir(root: &Path) -> Result<(DirLock, Option<String>), LockError> {
         .map_err(LockError::Io)?;
     match try_lock(&file) {
         Ok(()) => {}
-        Err(None) => {
-            let mut text = String::new();
-            let _ = file.read_to_string(&mut text);
-            return Err(LockError::Busy(text.trim().parse().ok()));
-        }
+        Err(None) => return Err(LockError::Busy(holder(&mut file))),
         Err(Some(e)) => {
             let note = format!(
                 "{}: cannot lock ({e}); nothing stops a second run from writing into this directory at the same time",
@@ -78,6 +74,29 @@ pub fn lock_dir(root: &Path) -> Result<(DirLock, Option<String>), LockError> {
         },
         None,
     ))
+}
+
+/// The id the lock's holder wrote. A holder writes it just after it takes the lock, so a
+/// run refused in that instant would read an empty file (or a dead earlier holder's id
+/// before the new one truncates it): read again for a moment until the id is of a live
+/// process, then report what is there.
+fn holder(file: &mut File) -> Option<u32> {
+    let read = |file: &mut File| -> Option<u32> {
+        let mut text = String::new();
+        file.seek(SeekFrom::Start(0)).ok()?;
+        file.read_to_string(&mut text).ok()?;
+        text.trim().parse().ok()
+    };
+    let alive =
+        |pid: u32| !Path::new("/proc").exists() || Path::new(&format!("/proc/{pid}")).exists();
+    let start = std::time::Instant::now();
+    loop {
+        let pid = read(file);
+        if pid.is_some_and(alive) || start.elapsed() > std::time::Duration::from_secs(1) {
+            return pid;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
 }
 
 /// The standard library's exclusive, non-blocking file lock (`flock(LOCK_EX | LOCK_NB)` on

@@ -411,7 +411,14 @@ impl OutputDir {
             Found::Read(m) if m.creator == "foldsynth" => m,
             other => return OutputDir::open_foreign(root, lock, &other, resume, force, notes),
         };
-        let same = settings.same_as(&old_settings);
+        let mut same = settings.same_as(&old_settings);
+        // A run killed before it wrote its settings wrote no records either: nothing of
+        // it can mix with this run, so it is resumed (or replaced) like one of the same
+        // settings.
+        let no_records = fs::metadata(root.join(RECORDS)).map_or(true, |m| m.len() == 0);
+        if matches!(old_settings, Found::Missing) && no_records {
+            same = Ok(());
+        }
         OutputDir::open_earlier(root, lock, &manifest, same, resume, force, notes)
     }
 
