@@ -392,3 +392,133 @@ fn panels_that_collide_are_reported_naming_them() {
     assert!(bill.is_null());
     assert!(String::from_utf8_lossy(&o.stderr).contains("--clearance"));
 }
+
+/// `design(dir)` with the `fabrication` block a search writes for a task with
+/// `[fabrication]`: the bill of the sample built at 4 mm and 50 mm per unit (`edit` changes
+/// it before it is written).
+fn design_with_bill(dir: &Path, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
+    let p = samples::single_crease(2.0, 9);
+    let spec = Fabrication {
+        thickness: 4.0,
+        scale: 50.0,
+        method: FabMethod::Tapered,
+        sides: Sides::Both,
+        hinge_gap: 0.3,
+        min_width: 1.0,
+    };
+    let ranges = fabricate::fold_ranges_refined(&p, &p.frames);
+    let bill = fabricate::build(&p, &ranges, &spec).unwrap().bill();
+    let mut doc = serde_json::json!({"pattern": p, "meta": {"task": "fab-test"},
+        "fabrication": {"bill": bill}});
+    edit(&mut doc);
+    let path = dir.join("design-bill.json");
+    std::fs::write(&path, doc.to_string()).unwrap();
+    path
+}
+
+#[test]
+fn the_material_comes_from_the_design_unless_a_flag_overrides_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = design_with_bill(dir.path(), |_| {});
+    let fab = |extra: &[&str], out: &str| {
+        let out = dir.path().join(out);
+        let mut a = vec![
+            "fabricate",
+            path.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        a.extend_from_slice(extra);
+        let o = run(&a);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let text = std::fs::read_to_string(out.join("fabrication.json")).unwrap();
+        (
+            o,
+            serde_json::from_str::<serde_json::Value>(&text).unwrap(),
+            out,
+        )
+    };
+    // No flags: every value is the bill's (4 mm, 50 mm per unit, both sides, 0.3 mm gap).
+    let (o, rec, out) = fab(&[], "from-design");
+    let b = &rec["fabrication"];
+    assert_eq!(b["thickness_mm"], 4.0);
+    assert_eq!(b["scale_mm_per_unit"], 50.0);
+    assert_eq!(b["sides"], "both");
+    assert_eq!(b["hinge_gap_mm"], 0.3);
+    for k in [
+        "thickness",
+        "scale",
+        "sides",
+        "hinge_gap",
+        "min_width",
+        "method",
+    ] {
+        assert_eq!(rec["material_from"][k], "design", "{k}");
+    }
+    assert!(out.join("ply-top.dxf").exists() && out.join("ply-bottom.dxf").exists());
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        said.contains("thickness from the design, scale from the design"),
+        "{said}"
+    );
+    // A flag wins over the bill, and the record says so.
+    let (_, rec, _) = fab(&["--thickness", "3", "--sides", "one"], "override");
+    assert_eq!(rec["fabrication"]["thickness_mm"], 3.0);
+    assert_eq!(rec["fabrication"]["sides"], "one");
+    assert_eq!(rec["fabrication"]["scale_mm_per_unit"], 50.0);
+    assert_eq!(rec["material_from"]["thickness"], "flag");
+    assert_eq!(rec["material_from"]["sides"], "flag");
+    assert_eq!(rec["material_from"]["scale"], "design");
+    // The flagged thickness is the one built: the crease's gap is 0.3 + 2·3·tan(1).
+    let gap = rec["fabrication"]["creases"][0]["gap_mm"].as_f64().unwrap();
+    assert!((gap - (0.3 + 6.0 * 1f64.tan())).abs() < 1e-9, "{gap}");
+}
+
+#[test]
+fn without_a_bill_or_with_a_bad_one_the_error_names_what_is_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    let (plain, _) = design(dir.path());
+    let out = dir.path().join("fab");
+    let refused = |args: &[&str], want: &[&str]| {
+        let o = run(args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        for w in want {
+            assert!(err.contains(w), "{args:?}: no {w:?} in {err}");
+        }
+    };
+    let (p, o) = (plain.to_str().unwrap(), out.to_str().unwrap());
+    refused(
+        &["fabricate", p, "--out", o],
+        &["--thickness: required", "design.json", "fabrication.bill"],
+    );
+    refused(
+        &["fabricate", p, "--thickness", "2", "--out", o],
+        &["--scale: required"],
+    );
+    let bad = design_with_bill(dir.path(), |d| {
+        d["fabrication"]["bill"]["thickness_mm"] = serde_json::json!(-1.0)
+    });
+    refused(
+        &["fabricate", bad.to_str().unwrap(), "--out", o],
+        &[
+            "design-bill.json",
+            "fabrication.bill.thickness_mm",
+            "(0, 10000]",
+        ],
+    );
+    let bad = design_with_bill(dir.path(), |d| {
+        d["fabrication"]["bill"]["sides"] = serde_json::json!("three")
+    });
+    refused(
+        &["fabricate", bad.to_str().unwrap(), "--out", o],
+        &["fabrication.bill.sides", "allowed: one, both"],
+    );
+    let bad = design_with_bill(dir.path(), |d| {
+        d["fabrication"]["bill"] = serde_json::json!({"thickness_mm": "thick"})
+    });
+    refused(
+        &["fabricate", bad.to_str().unwrap(), "--out", o],
+        &["fabrication.bill is not a bill"],
+    );
+}

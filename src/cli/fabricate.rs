@@ -1,6 +1,8 @@
-//! `foldsynth fabricate DESIGN.json --thickness MM --scale MM_PER_UNIT --out DIR`: thick
+//! `foldsynth fabricate DESIGN.json [--thickness MM] [--scale MM_PER_UNIT] --out DIR`: thick
 //! panels for a design (issue 32): ply drawings (DXF R12 + SVG), panel solids and
 //! assemblies (STL + 3MF), and `fabrication.json` (the bill and the hinge axes).
+//! The material comes from the flags, then from the design's `fabrication.bill` (a search
+//! with `[fabrication]` writes one), then from the defaults; the record says which.
 
 use std::path::PathBuf;
 
@@ -18,24 +20,29 @@ use crate::task::fabrication::{
 pub struct FabricateArgs {
     /// Design JSON as `synthesize` writes it (`OUT/designs/<id>.json`).
     pub design: PathBuf,
-    /// Panel thickness in mm.
+    /// Panel thickness in mm (default: the design's `fabrication.bill`; required without
+    /// one).
     #[arg(long, allow_hyphen_values = true)]
-    pub thickness: f64,
-    /// mm per paper unit (the design's first crease of G0 is 1 unit).
+    pub thickness: Option<f64>,
+    /// mm per paper unit, the design's first crease of G0 being 1 unit (default: the
+    /// design's `fabrication.bill`; required without one).
     #[arg(long, allow_hyphen_values = true)]
-    pub scale: f64,
-    /// The construction: tapered (volume trimming, Tachi 2011).
-    #[arg(long, default_value = "tapered")]
-    pub method: String,
+    pub scale: Option<f64>,
+    /// The construction: tapered (volume trimming, Tachi 2011). Default: the design's
+    /// bill, else tapered.
+    #[arg(long)]
+    pub method: Option<String>,
     /// Where the slab lies: one (on the +normal side of the sheet) or both (centred).
-    #[arg(long, default_value = "one")]
-    pub sides: String,
-    /// Smallest gap between two panels at a crease, mm.
-    #[arg(long, default_value_t = DEFAULT_HINGE_GAP_MM, allow_hyphen_values = true)]
-    pub hinge_gap: f64,
-    /// Narrowest a trimmed panel may become, mm.
-    #[arg(long, default_value_t = DEFAULT_MIN_WIDTH_MM, allow_hyphen_values = true)]
-    pub min_width: f64,
+    /// Default: the design's bill, else one.
+    #[arg(long)]
+    pub sides: Option<String>,
+    /// Smallest gap between two panels at a crease, mm. Default: the design's bill, else
+    /// 0.5.
+    #[arg(long, allow_hyphen_values = true)]
+    pub hinge_gap: Option<f64>,
+    /// Narrowest a trimmed panel may become, mm. Default: the design's bill, else 2.
+    #[arg(long, allow_hyphen_values = true)]
+    pub min_width: Option<f64>,
     /// The least gap, mm, between two panels that share no vertex, checked on every frame
     /// of the design (panels that share a crease or a vertex must not cross).
     #[arg(long, default_value_t = DEFAULT_CLEARANCE_MM, allow_hyphen_values = true)]
@@ -52,29 +59,111 @@ pub struct FabricateArgs {
 /// `--clearance`'s default, mm: half a millimetre between panels that pass each other.
 pub const DEFAULT_CLEARANCE_MM: f64 = 0.5;
 
-/// The setting from the flags; errors name the flag.
-fn setting(a: &FabricateArgs) -> anyhow::Result<Fabrication> {
-    let Some(method) = FabMethod::from_name(&a.method) else {
-        bail!(
-            "--method: unknown method '{}'; allowed: {}",
-            crate::text::excerpt(&a.method, 40),
-            FabMethod::NAMES.join(", ")
-        );
+/// Where each value of the setting came from: `"flag"`, `"design"` (its
+/// `fabrication.bill`) or `"default"`.
+type Sources = serde_json::Map<String, serde_json::Value>;
+
+/// A design file's `fabrication.bill` (as `synthesize` writes it for a task with
+/// `[fabrication]`), validated; `None` when the file has none. Errors name the file and
+/// the bill's field.
+fn design_bill(path: &std::path::Path) -> anyhow::Result<Option<Fabrication>> {
+    let text = crate::limits::read_text(path).with_context(|| format!("{}", path.display()))?;
+    let doc: serde_json::Value = serde_json::from_str(&text)
+        .with_context(|| format!("{}: not a JSON design file", path.display()))?;
+    let raw = &doc["fabrication"]["bill"];
+    if raw.is_null() {
+        return Ok(None);
+    }
+    let bill: fabricate::Bill = serde_json::from_value(raw.clone()).with_context(|| {
+        format!(
+            "{}: fabrication.bill is not a bill as synthesize writes it",
+            path.display()
+        )
+    })?;
+    match bill.setting() {
+        Ok(spec) => Ok(Some(spec)),
+        Err((field, message)) => bail!(
+            "{}: fabrication.bill.{}: {message}",
+            path.display(),
+            fabricate::Bill::field_name(field)
+        ),
+    }
+}
+
+/// The setting from the flags, then the design's bill, then the defaults (thickness and
+/// scale have none); errors name the flag (or the design's field). With it, where each
+/// value came from.
+fn setting(a: &FabricateArgs) -> anyhow::Result<(Fabrication, Sources)> {
+    let bill = design_bill(&a.design)?;
+    let mut from = Sources::new();
+    let mut pick = |name: &str, flag: Option<f64>, design: Option<f64>, default: Option<f64>| {
+        let (v, src) = match (flag, design, default) {
+            (Some(v), _, _) => (v, "flag"),
+            (None, Some(v), _) => (v, "design"),
+            (None, None, Some(v)) => (v, "default"),
+            (None, None, None) => bail!(
+                "--{name}: required: {} has no fabrication.bill to take it from (a design of a task with [fabrication] has one)",
+                a.design.display()
+            ),
+        };
+        from.insert(name.replace('-', "_"), src.into());
+        Ok::<_, anyhow::Error>(v)
     };
-    let Some(sides) = Sides::from_name(&a.sides) else {
-        bail!(
-            "--sides: unknown value '{}'; allowed: {}",
-            crate::text::excerpt(&a.sides, 40),
-            Sides::NAMES.join(", ")
-        );
+    let thickness = pick("thickness", a.thickness, bill.map(|b| b.thickness), None)?;
+    let scale = pick("scale", a.scale, bill.map(|b| b.scale), None)?;
+    let hinge_gap = pick(
+        "hinge-gap",
+        a.hinge_gap,
+        bill.map(|b| b.hinge_gap),
+        Some(DEFAULT_HINGE_GAP_MM),
+    )?;
+    let min_width = pick(
+        "min-width",
+        a.min_width,
+        bill.map(|b| b.min_width),
+        Some(DEFAULT_MIN_WIDTH_MM),
+    )?;
+    let method = match &a.method {
+        Some(name) => {
+            from.insert("method".into(), "flag".into());
+            FabMethod::from_name(name).with_context(|| {
+                format!(
+                    "--method: unknown method '{}'; allowed: {}",
+                    crate::text::excerpt(name, 40),
+                    FabMethod::NAMES.join(", ")
+                )
+            })?
+        }
+        None => {
+            let src = if bill.is_some() { "design" } else { "default" };
+            from.insert("method".into(), src.into());
+            bill.map_or(FabMethod::Tapered, |b| b.method)
+        }
+    };
+    let sides = match &a.sides {
+        Some(name) => {
+            from.insert("sides".into(), "flag".into());
+            Sides::from_name(name).with_context(|| {
+                format!(
+                    "--sides: unknown value '{}'; allowed: {}",
+                    crate::text::excerpt(name, 40),
+                    Sides::NAMES.join(", ")
+                )
+            })?
+        }
+        None => {
+            let src = if bill.is_some() { "design" } else { "default" };
+            from.insert("sides".into(), src.into());
+            bill.map_or(Sides::One, |b| b.sides)
+        }
     };
     let spec = Fabrication {
-        thickness: a.thickness,
-        scale: a.scale,
+        thickness,
+        scale,
         method,
         sides,
-        hinge_gap: a.hinge_gap,
-        min_width: a.min_width,
+        hinge_gap,
+        min_width,
     };
     if let Err((field, message)) = spec.validate() {
         bail!("--{}: {message}", field.replace('_', "-"));
@@ -86,7 +175,7 @@ fn setting(a: &FabricateArgs) -> anyhow::Result<Fabrication> {
             crate::text::num(a.clearance)
         );
     }
-    Ok(spec)
+    Ok((spec, from))
 }
 
 /// The states asked for, as (name, frame index or `None` for flat).
@@ -128,8 +217,8 @@ fn states(
 
 /// Run `foldsynth fabricate`.
 pub fn run(a: FabricateArgs) -> anyhow::Result<()> {
-    let spec = setting(&a)?;
     let d = DesignFile::read(&a.design)?;
+    let (spec, from) = setting(&a)?;
     let pattern = &d.pattern;
     let wanted = states(&a.states, &pattern.frames)?;
     let ranges = fabricate::fold_ranges_refined(pattern, &pattern.frames);
@@ -160,17 +249,20 @@ pub fn run(a: FabricateArgs) -> anyhow::Result<()> {
         "design": a.design.display().to_string(),
         "states": wanted.iter().map(|(n, f)| serde_json::json!({"name": n, "frame": f})).collect::<Vec<_>>(),
         "fabrication": bill,
+        "material_from": from,
         "check": check,
     }))?;
     std::fs::write(&json, text + "\n").with_context(|| format!("{}", json.display()))?;
     files.push(json);
     println!(
-        "{} panels, {} hinges, {} mm thick (sides = {}) at {} mm per unit; widest hinge gap {:.3} mm",
+        "{} panels, {} hinges, {} mm thick (sides = {}) at {} mm per unit (thickness from the {}, scale from the {}); widest hinge gap {:.3} mm",
         design.panels.len(),
         design.hinges.len(),
         crate::text::num(spec.thickness),
         spec.sides.name(),
         crate::text::num(spec.scale),
+        from["thickness"].as_str().unwrap_or_default(),
+        from["scale"].as_str().unwrap_or_default(),
         design.hinges.iter().map(|h| h.gap_mm).fold(0.0, f64::max)
     );
     for f in files {

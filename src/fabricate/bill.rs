@@ -2,6 +2,7 @@
 
 use super::ThickDesign;
 use crate::geom;
+use crate::task::fabrication::{FabMethod, Fabrication, Sides};
 use serde::{Deserialize, Serialize};
 
 /// One layer of a panel in mm.
@@ -146,6 +147,55 @@ impl ThickDesign {
             total_area_mm2: panels.iter().map(|p| p.area_mm2).sum(),
             panels,
             creases,
+        }
+    }
+}
+
+impl Bill {
+    /// The setting this bill was built with, validated: how `foldsynth fabricate` takes the
+    /// material from a design file (`fabrication.bill` of `designs/<id>.json`) when its
+    /// flags leave it out. `Err((field, what is allowed))` names the bill's field.
+    pub fn setting(&self) -> Result<Fabrication, (&'static str, String)> {
+        let method = FabMethod::from_name(&self.method).ok_or_else(|| {
+            (
+                "method",
+                format!(
+                    "unknown method '{}'; allowed: {}",
+                    crate::text::excerpt(&self.method, 40),
+                    FabMethod::NAMES.join(", ")
+                ),
+            )
+        })?;
+        let sides = Sides::from_name(&self.sides).ok_or_else(|| {
+            (
+                "sides",
+                format!(
+                    "unknown value '{}'; allowed: {}",
+                    crate::text::excerpt(&self.sides, 40),
+                    Sides::NAMES.join(", ")
+                ),
+            )
+        })?;
+        let spec = Fabrication {
+            thickness: self.thickness_mm,
+            scale: self.scale_mm_per_unit,
+            method,
+            sides,
+            hinge_gap: self.hinge_gap_mm,
+            min_width: self.min_width_mm,
+        };
+        spec.validate().map(|()| spec)
+    }
+
+    /// The bill's field named by [`Fabrication::validate`]'s `field`.
+    pub fn field_name(field: &str) -> &'static str {
+        match field {
+            "thickness" => "thickness_mm",
+            "scale" => "scale_mm_per_unit",
+            "hinge_gap" => "hinge_gap_mm",
+            "min_width" => "min_width_mm",
+            "method" => "method",
+            _ => "sides",
         }
     }
 }
