@@ -1,4 +1,4 @@
-//! `foldsynth export DESIGN.json --format fold|svg|obj|stl|scene-obj|scene-stl|gif|png|state-svg|all`.
+//! `foldsynth export DESIGN.json --format fold|svg|obj|stl|scene-obj|scene-stl|gif|png|state-svg|print|all`.
 //!
 //! The design file is `{"pattern": <Pattern>, "meta": <DesignMeta>}` (see
 //! [`crate::export::DesignFile`]); the synthesis stage writes one per feasible design.
@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 
-use crate::export::{self, DesignFile, ExportOptions, FoldSpec, mesh, render, scene_mesh, svg};
+use crate::export::{
+    self, DesignFile, ExportOptions, FoldSpec, mesh, render, scene_mesh, sheet, svg,
+};
 
 /// What to write.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -30,6 +32,8 @@ pub enum Format {
     Png,
     /// SVG picture of one folded state.
     StateSvg,
+    /// The print sheet at true scale on paper (PDF, and an SVG per sheet beside it).
+    Print,
     /// Everything, into the directory --out.
     All,
 }
@@ -46,6 +50,7 @@ impl Format {
             Format::Gif => "gif",
             Format::Png => "png",
             Format::StateSvg => "state.svg",
+            Format::Print => "print.pdf",
             Format::All => "export",
         }
     }
@@ -100,6 +105,14 @@ pub struct ExportArgs {
     /// Camera elevation in degrees, in (−90, 90).
     #[arg(long, default_value_t = 25.0, allow_hyphen_values = true)]
     pub elevation: f64,
+    /// Paper of the print sheet (print, all): a4, letter, a3 or WIDTHxHEIGHT in mm.
+    #[arg(long, default_value = "a4", value_parser = sheet::Paper::parse)]
+    pub paper: sheet::Paper,
+    /// Scale of the print sheet (print, all): mm per paper unit (G0's first crease is 1
+    /// unit), or fit (the largest of 1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k mm that fits
+    /// one sheet). A pattern larger than the paper is split over several sheets.
+    #[arg(long, default_value = "fit", value_parser = sheet::PrintScale::parse, allow_hyphen_values = true)]
+    pub print_scale: sheet::PrintScale,
 }
 
 fn default_out(design: &Path, f: Format) -> PathBuf {
@@ -141,6 +154,17 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
         ),
         Some(k) => Some(k),
         None => n.checked_sub(1),
+    };
+    let print = sheet::SheetOptions {
+        paper: a.paper.clone(),
+        scale: a.print_scale,
+        labels: a.labels,
+        title: a
+            .design
+            .file_stem()
+            .map_or("design".into(), |s| s.to_string_lossy().into_owned()),
+        copies: meta.scene.copies,
+        ..Default::default()
     };
     let write = |bytes: Vec<u8>| -> anyhow::Result<()> {
         std::fs::write(&out, bytes).with_context(|| format!("writing {}", out.display()))
@@ -198,6 +222,32 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
                 .svg(frame, a.size)
                 .into_bytes(),
         )?,
+        Format::Print => {
+            if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(dir)
+                    .with_context(|| format!("--out: cannot create {}", dir.display()))?;
+            }
+            let (print, files) = sheet::write(&out, p, &print)?;
+            println!(
+                "{} sheet(s) of {} ({} x {}{}) at {} mm per unit; cut line {} mm",
+                print.pages.len(),
+                print.paper,
+                print.grid[0],
+                print.grid[1],
+                if print.landscape { ", landscape" } else { "" },
+                crate::text::num(print.mm_per_unit),
+                crate::text::num(
+                    (print.sheet.cut_length() * print.mm_per_unit * 10.0).round() / 10.0
+                )
+            );
+            if let Some(n) = &print.sheet.note {
+                eprintln!("note: {}: {n}", a.design.display());
+            }
+            for f in files {
+                println!("wrote {}", f.display());
+            }
+            return Ok(());
+        }
         Format::All => {
             let name = a
                 .design
@@ -212,6 +262,7 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
                 image_size: a.size,
                 camera,
                 stl_binary: !a.stl_ascii,
+                print: Some(print),
                 ..ExportOptions::default()
             };
             let files = export::write_all(&out, p, meta, &opts)?;

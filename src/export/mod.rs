@@ -42,6 +42,7 @@ pub mod report;
 pub mod samples;
 pub mod scene_mesh;
 pub mod scene_polys;
+pub mod sheet;
 pub mod svg;
 pub mod verify;
 
@@ -390,6 +391,9 @@ pub struct ExportOptions {
     pub camera: render::Camera,
     /// Binary STL (`true`) or ASCII STL (`false`).
     pub stl_binary: bool,
+    /// The print sheet (`<name>.print.pdf` and its SVGs; [`sheet`]), `None` for none. Its
+    /// `title` and `copies` are set from `name` and the design's meta when written.
+    pub print: Option<sheet::SheetOptions>,
 }
 
 impl Default for ExportOptions {
@@ -406,6 +410,7 @@ impl Default for ExportOptions {
             gif_max_frames: 60,
             camera: render::Camera::default(),
             stl_binary: true,
+            print: Some(sheet::SheetOptions::default()),
         }
     }
 }
@@ -431,6 +436,8 @@ pub struct Files {
     pub folded_svgs: Vec<PathBuf>,
     /// The animated GIF of the motion, if written.
     pub gif: Option<PathBuf>,
+    /// The print sheet: the PDF, then one SVG per sheet (empty without one).
+    pub print: Vec<PathBuf>,
 }
 
 /// Indices of `count` frames spread evenly over `n` frames, always including the last.
@@ -467,13 +474,19 @@ impl Files {
             v.push(svg.clone());
         }
         v.extend(self.gif.clone());
+        v.extend(self.print.iter().cloned());
         v
     }
 }
 
 /// The files [`write_all`] writes for `pattern` with `opts` into `out_dir` (so a caller can
 /// list them before they exist).
-pub fn planned_files(out_dir: &Path, pattern: &Pattern, opts: &ExportOptions) -> Files {
+pub fn planned_files(
+    out_dir: &Path,
+    pattern: &Pattern,
+    meta: &DesignMeta,
+    opts: &ExportOptions,
+) -> Files {
     let path = |ext: &str| out_dir.join(format!("{}.{ext}", opts.name));
     let picked = picked_frames(pattern.frames.len(), opts.picture_states);
     Files {
@@ -492,7 +505,24 @@ pub fn planned_files(out_dir: &Path, pattern: &Pattern, opts: &ExportOptions) ->
             .map(|k| out_dir.join(format!("{}_state{k}.svg", opts.name)))
             .collect(),
         gif: (opts.gif && !pattern.frames.is_empty()).then(|| path("gif")),
+        print: match print_options(meta, opts) {
+            // A layout that fails here fails again in write_all, which says why.
+            Some(o) => {
+                let sheets = sheet::layout(pattern, &o).map_or(1, |p| p.pages.len());
+                sheet::planned(&path("print.pdf"), sheets)
+            }
+            None => Vec::new(),
+        },
     }
+}
+
+/// The print sheet's options of a design: `opts.print` with its name and copies.
+fn print_options(meta: &DesignMeta, opts: &ExportOptions) -> Option<sheet::SheetOptions> {
+    opts.print.clone().map(|o| sheet::SheetOptions {
+        title: opts.name.clone(),
+        copies: meta.scene.copies,
+        ..o
+    })
 }
 
 /// Write every file for one design into `out_dir` (created if missing): FOLD, crease
@@ -518,7 +548,7 @@ pub fn write_all(
         path: out_dir.to_path_buf(),
         source,
     })?;
-    let files = planned_files(out_dir, pattern, opts);
+    let files = planned_files(out_dir, pattern, meta, opts);
     let loaded = with_meshes(meta)?;
     let meta = &*loaded;
     write_file(
@@ -578,6 +608,9 @@ pub fn write_all(
     {
         write_file(path, png)?;
         write_file(fsvg, scene.svg(Some(*k), opts.image_size))?;
+    }
+    if let (Some(o), Some(pdf)) = (print_options(meta, opts), files.print.first()) {
+        sheet::write(pdf, pattern, &o)?;
     }
     Ok(files)
 }

@@ -85,7 +85,7 @@ pub(super) fn write_designs(
             .map(|w| format!("designs/{}", w.id))
             .collect();
         for (w, dir) in with_dir.into_iter().zip(out_dir.create_dirs(&dirs)?) {
-            files.extend(export::planned_files(&dir, &w.pattern, &w.options).all());
+            files.extend(export::planned_files(&dir, &w.pattern, &w.meta, &w.options).all());
         }
         out_dir.register(&files)?;
         let written = pool.install(|| {
@@ -218,6 +218,16 @@ fn build_design(
         doc: serde_json::to_string(&doc).unwrap_or_default() + "\n",
         options: ExportOptions {
             name: id.clone(),
+            // A task with [fabrication] prints at its scale, the paper model of its panels.
+            print: Some(export::sheet::SheetOptions {
+                scale: task
+                    .fabrication
+                    .as_ref()
+                    .map_or(export::sheet::PrintScale::Fit, |f| {
+                        export::sheet::PrintScale::MmPerUnit(f.scale)
+                    }),
+                ..Default::default()
+            }),
             ..Default::default()
         },
         thick: thick
