@@ -222,32 +222,7 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
                 .svg(frame, a.size)
                 .into_bytes(),
         )?,
-        Format::Print => {
-            if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-                std::fs::create_dir_all(dir)
-                    .with_context(|| format!("--out: cannot create {}", dir.display()))?;
-            }
-            let (print, files) = sheet::write(&out, p, &print)?;
-            println!(
-                "{} sheet(s) of {} ({} x {}{}) at {} mm per unit; cut line {} mm",
-                print.pages.len(),
-                print.paper,
-                print.grid[0],
-                print.grid[1],
-                if print.landscape { ", landscape" } else { "" },
-                crate::text::num(print.mm_per_unit),
-                crate::text::num(
-                    (print.sheet.cut_length() * print.mm_per_unit * 10.0).round() / 10.0
-                )
-            );
-            if let Some(n) = &print.sheet.note {
-                eprintln!("note: {}: {n}", a.design.display());
-            }
-            for f in files {
-                println!("wrote {}", f.display());
-            }
-            return Ok(());
-        }
+        Format::Print => return print_sheet(&a, &out, p, &print),
         Format::All => {
             let name = a
                 .design
@@ -271,5 +246,36 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
         }
     }
     println!("{}", out.display());
+    Ok(())
+}
+
+/// `--format print`: the sheets, and what was written.
+fn print_sheet(
+    a: &ExportArgs,
+    out: &Path,
+    p: &crate::pattern::Pattern,
+    print: &sheet::SheetOptions,
+) -> anyhow::Result<()> {
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("--out: cannot create {}", dir.display()))?;
+    }
+    let (print, files) = sheet::write(out, p, print)?;
+    println!(
+        "{} sheet(s) of {} ({} x {}{}) at {} mm per unit; cut line {} mm",
+        print.pages.len(),
+        print.paper,
+        print.grid[0],
+        print.grid[1],
+        if print.landscape { ", landscape" } else { "" },
+        crate::text::num(print.mm_per_unit),
+        crate::text::num((print.sheet.cut_length() * print.mm_per_unit * 10.0).round() / 10.0)
+    );
+    if let Some(n) = &print.sheet.note {
+        eprintln!("note: {}: {n}", a.design.display());
+    }
+    for f in files {
+        println!("wrote {}", f.display());
+    }
     Ok(())
 }
