@@ -155,17 +155,7 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
         Some(k) => Some(k),
         None => n.checked_sub(1),
     };
-    let print = sheet::SheetOptions {
-        paper: a.paper.clone(),
-        scale: a.print_scale,
-        labels: a.labels,
-        title: a
-            .design
-            .file_stem()
-            .map_or("design".into(), |s| s.to_string_lossy().into_owned()),
-        copies: meta.scene.copies,
-        ..Default::default()
-    };
+    let print = sheet_options(&a, meta);
     let write = |bytes: Vec<u8>| -> anyhow::Result<()> {
         std::fs::write(&out, bytes).with_context(|| format!("writing {}", out.display()))
     };
@@ -278,4 +268,19 @@ fn print_sheet(
         println!("wrote {}", f.display());
     }
     Ok(())
+}
+
+/// The print sheet's options from the flags; the copies are the design's.
+fn sheet_options(a: &ExportArgs, meta: &export::DesignMeta) -> sheet::SheetOptions {
+    sheet::SheetOptions {
+        paper: a.paper.clone(),
+        scale: a.print_scale,
+        labels: a.labels,
+        title: a
+            .design
+            .file_stem()
+            .map_or("design".into(), |s| s.to_string_lossy().into_owned()),
+        copies: meta.scene.copies,
+        ..Default::default()
+    }
 }
