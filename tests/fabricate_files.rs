@@ -217,16 +217,22 @@ fn independent_readers(out: &Path, thick: &fabricate::ThickDesign) {
             );
         }
     }
-    // The rigid ply's cut outlines are the panels' top layers, in mm, as written.
+    // The rigid ply's cut outlines are the panels' top layers, in mm, as written, moved
+    // onto the sheet by the layout's offset; then the sheet's outline.
+    let rec: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("fabrication.json")).unwrap())
+            .unwrap();
+    let offset = rec["laminate"]["offset_mm"].as_array().unwrap().clone();
     let cut = r["rigid"]["cut"].as_array().unwrap();
-    assert_eq!(cut.len(), thick.panels.len());
+    assert_eq!(cut.len(), thick.panels.len() + 1);
     for (panel, poly) in thick.panels.iter().zip(cut) {
         let top = &panel.layers.last().unwrap().outline;
         let pts = poly.as_array().unwrap();
         assert_eq!(pts.len(), top.len());
         for (p, q) in top.iter().zip(pts) {
             for k in 0..2 {
-                assert!((p[k] * 50.0 - q[k].as_f64().unwrap()).abs() < 1e-9);
+                let at = p[k] * 50.0 + offset[k].as_f64().unwrap();
+                assert!((at - q[k].as_f64().unwrap()).abs() < 1e-9);
             }
         }
     }
