@@ -201,6 +201,15 @@ impl Laminate {
         within("kerf", self.kerf, false)?;
         within("tab_width", self.tab_width, false)?;
         within("hole", self.hole, true)?;
+        if self.hole <= self.kerf {
+            return Err((
+                "hole",
+                format!(
+                    "{} mm is not wider than the kerf {} mm: allowed a diameter above the kerf",
+                    self.hole, self.kerf
+                ),
+            ));
+        }
         if let Some([w, h]) = self.sheet {
             within("sheet", w, true)?;
             within("sheet", h, true)?;
