@@ -340,7 +340,7 @@ fn a_thick_run_writes_the_fabrication_files_of_its_top_designs() {
             "fabrication.json",
         ] {
             assert!(
-                files.iter().any(|f| f == &format!("{id}/{name}").as_str()),
+                files.iter().any(|f| f == format!("{id}/{name}").as_str()),
                 "{id}: {name}"
             );
         }
@@ -349,6 +349,7 @@ fn a_thick_run_writes_the_fabrication_files_of_its_top_designs() {
         assert_eq!(rec["fabrication"], d["fabrication"]["bill"], "{id}");
         assert_eq!(rec["check"], d["fabrication"]["check"], "{id}");
         assert_eq!(rec["material_from"], "task");
+        assert_eq!(rec["design"], format!("designs/{id}.json"));
         assert_eq!(
             rec["states"][2]["frame"], 180,
             "{id}: the dense sweep's last state"

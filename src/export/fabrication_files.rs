@@ -38,7 +38,7 @@ pub fn ply_names(design: &ThickDesign) -> Vec<&'static str> {
     }
 }
 
-/// The files [`write`] writes into `dir` for `design` and the states named `states`, in
+/// The files [`write()`] writes into `dir` for `design` and the states named `states`, in
 /// writing order (so a caller can list them before they exist).
 pub fn planned(dir: &Path, design: &ThickDesign, states: &[&str]) -> Vec<PathBuf> {
     let mut out = Vec::new();

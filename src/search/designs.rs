@@ -367,7 +367,9 @@ fn write_design(
             let all = export::write_all(&out, &w.pattern, &w.meta, &w.options).map_err(err)?;
             let check = verified(&all.fold)?;
             if let Some(fab) = &w.fab {
-                write_fab(&out, &path, fab, &w.rec).map_err(err)?;
+                // The design JSON as the run's folder names it (the same on every machine).
+                let json = Path::new("designs").join(format!("{id}.json"));
+                write_fab(&out, &json, fab, &w.rec).map_err(err)?;
             }
             (Some(all), Some(check))
         } else {
@@ -406,7 +408,8 @@ fn write_design(
 }
 
 /// Write a thick design's files into its folder `out` (as `foldsynth fabricate` writes
-/// them): `fabrication.json` records the design JSON, that the material is the task's, and
+/// them): `fabrication.json` records the design JSON (`json`, relative to the run's
+/// folder), that the material is the task's, and
 /// the search's thick check.
 fn write_fab(
     out: &Path,
