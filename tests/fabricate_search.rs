@@ -24,6 +24,9 @@ use std::collections::HashMap;
 #[allow(dead_code)] // only the runner is used here
 mod runs;
 
+#[path = "common/fab_files.rs"]
+mod fab_files;
+
 const GRIPPER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper.toml");
 
 const FULL: Effort = Effort {
@@ -277,4 +280,81 @@ fn a_thick_gripper_run_keeps_every_panel_clear_on_the_dense_sweep() {
         );
     }
     assert_eq!(jsons, designs.len());
+}
+
+/// Issue 50: a thick task hands over its files. The two most robust designs of a small
+/// thick gripper run get their plies, panel solids, assemblies and `fabrication.json` in
+/// their folders, listed in the run's manifest and in the design JSON's
+/// `fabrication.files`, and they read back with the same independent readers as
+/// `foldsynth fabricate`'s; the others get none.
+#[test]
+fn a_thick_run_writes_the_fabrication_files_of_its_top_designs() {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/grammar/gripper_thick.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    runs::foldsynth_ok(&[
+        "synthesize",
+        file,
+        "--n-max",
+        "2",
+        "--export",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+    let listed: Vec<&str> = manifest["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    let mut with_files = 0;
+    for e in std::fs::read_dir(out.join("designs")).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_none_or(|x| x != "json") {
+            continue;
+        }
+        let d: serde_json::Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+        let id = d["id"].as_str().unwrap();
+        let folder = out.join("designs").join(id);
+        let Some(files) = d["fabrication"]["files"].as_array() else {
+            assert!(!folder.join("fabrication.json").exists(), "{id}");
+            continue;
+        };
+        with_files += 1;
+        assert!(d["rank"].as_u64().unwrap() <= 2, "{id}");
+        for f in files {
+            let f = f.as_str().unwrap();
+            assert!(out.join("designs").join(f).is_file(), "{id}: {f} missing");
+            assert!(
+                listed.contains(&format!("designs/{f}").as_str()),
+                "{f} not in the manifest"
+            );
+        }
+        for name in [
+            "ply-rigid.dxf",
+            "ply-hinge.svg",
+            "assembly-half.3mf",
+            "fabrication.json",
+        ] {
+            assert!(
+                files.iter().any(|f| f == format!("{id}/{name}").as_str()),
+                "{id}: {name}"
+            );
+        }
+        let rec = fab_files::record(&folder);
+        // The bill of the files is the design JSON's, the check the search's.
+        assert_eq!(rec["fabrication"], d["fabrication"]["bill"], "{id}");
+        assert_eq!(rec["check"], d["fabrication"]["check"], "{id}");
+        assert_eq!(rec["material_from"], "task");
+        assert_eq!(rec["design"], format!("designs/{id}.json"));
+        assert_eq!(
+            rec["states"][2]["frame"], 180,
+            "{id}: the dense sweep's last state"
+        );
+        fab_files::independent_readers(&folder);
+    }
+    assert_eq!(with_files, 2);
 }

@@ -1134,6 +1134,21 @@ fn the_fabrication_table_is_read_with_its_defaults() {
     assert_eq!((f.thickness, f.scale), (2.0, 100.0));
     assert_eq!((f.method, f.sides), (FabMethod::Tapered, Sides::One));
     assert_eq!((f.hinge_gap, f.min_width), (0.5, 2.0));
+    assert_eq!(
+        t.laminate,
+        foldsynth::task::fabrication::Laminate::default()
+    );
+    let t = Task::from_toml_str(
+        &(BASE.to_owned()
+            + "[fabrication]\nthickness = 2\nscale = 100\nkerf = 0.15\ntab_width = 1\nhole = 4\nsheet = \"600x400\"\n"),
+        "ok.toml",
+    )
+    .unwrap();
+    let l = t.laminate;
+    assert_eq!(
+        (l.kerf, l.tab_width, l.hole, l.sheet),
+        (0.15, 1.0, 4.0, Some([600.0, 400.0]))
+    );
     // 2 mm at 100 mm per unit, one side: every panel point within 0.02 units of its facet.
     assert_eq!(f.reach_units(), 0.02);
     let t = Task::from_toml_str(
@@ -1211,6 +1226,26 @@ fn bad_fabrication_values_are_refused_with_file_and_field() {
             "thickness = 2\nscale = 100\nhinge_gap = -0.5\n",
             "fabrication.hinge_gap",
             &["[0, "][..],
+        ),
+        (
+            "thickness = 2\nscale = 100\nkerf = -0.1\n",
+            "fabrication.kerf",
+            &["[0, "][..],
+        ),
+        (
+            "thickness = 2\nscale = 100\ntab_width = -1\n",
+            "fabrication.tab_width",
+            &["[0, "][..],
+        ),
+        (
+            "thickness = 2\nscale = 100\nhole = 0\n",
+            "fabrication.hole",
+            &["(0, "][..],
+        ),
+        (
+            "thickness = 2\nscale = 100\nsheet = \"axb\"\n",
+            "fabrication.sheet",
+            &["WxH"][..],
         ),
         (
             "thickness = 2\nscale = 100\nmin_width = 150\n",

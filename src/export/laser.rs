@@ -15,6 +15,11 @@
 //! - `MOUNTAIN`, `VALLEY`: hinge ply: the creases by the sign of their largest fold (a
 //!   crease folding both ways goes by the larger).
 //! - `LABEL`: panel ids (`P3` is facet 3 of the design), as text.
+//! - `REGISTER`: registration crosses at the sheet's corners, the same on every ply
+//!   (engrave lightly, or use them to place the sheet); see [`super::laminate`].
+//!
+//! On every ply, `CUT` also holds the sheet's outline and the alignment holes (circles)
+//! that [`super::laminate`] adds.
 //!
 //! Why not ORIPA's `CutLine`/`MountainLine`/`ValleyLine`: laser software (LightBurn,
 //! LaserGRBL) assigns an operation per layer, and a laminate needs a cut, a light score and
@@ -22,7 +27,7 @@
 //! ORIPA does not read plies.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::{ExportError, Result};
 use crate::fabricate::ThickDesign;
@@ -30,7 +35,7 @@ use crate::pattern::{EdgeKind, Pattern};
 use crate::task::fabrication::Sides;
 
 /// The layer names of every drawing.
-pub const LAYERS: [&str; 5] = ["CUT", "SCORE", "MOUNTAIN", "VALLEY", "LABEL"];
+pub const LAYERS: [&str; 6] = ["CUT", "SCORE", "MOUNTAIN", "VALLEY", "LABEL", "REGISTER"];
 
 /// One line or closed polygon of a drawing, mm.
 #[derive(Clone, Debug, PartialEq)]
@@ -41,6 +46,8 @@ pub struct Path2 {
     pub points: Vec<[f64; 2]>,
     /// Whether the last corner joins the first.
     pub closed: bool,
+    /// The panel (facet) whose outline this is, on a rigid ply's `CUT`.
+    pub panel: Option<usize>,
 }
 
 /// One ply's drawing, mm.
@@ -52,6 +59,8 @@ pub struct PlyDrawing {
     pub paths: Vec<Path2>,
     /// Labels: text, where (mm), height (mm).
     pub labels: Vec<(String, [f64; 2], f64)>,
+    /// Circles on `CUT` (the alignment holes): centre (mm), radius (mm).
+    pub circles: Vec<([f64; 2], f64)>,
 }
 
 /// The drawings of every ply of `design`.
@@ -79,6 +88,7 @@ pub fn plies(pattern: &Pattern, design: &ThickDesign) -> Vec<PlyDrawing> {
                 layer: "CUT",
                 points: pts,
                 closed: true,
+                panel: Some(p.facet),
             });
         }
         for h in &design.hinges {
@@ -86,25 +96,32 @@ pub fn plies(pattern: &Pattern, design: &ThickDesign) -> Vec<PlyDrawing> {
                 layer: "SCORE",
                 points: vec![mm(h.axis[0]), mm(h.axis[1])],
                 closed: false,
+                panel: None,
             });
         }
         out.push(PlyDrawing {
             name,
             paths,
             labels,
+            circles: Vec::new(),
         });
     }
-    let mut paths = Vec::new();
-    for e in &pattern.edges {
-        let pts = vec![mm(pattern.vertices[e.v[0]]), mm(pattern.vertices[e.v[1]])];
-        if matches!(e.kind, EdgeKind::Boundary) {
-            paths.push(Path2 {
-                layer: "CUT",
-                points: pts,
-                closed: false,
-            });
-        }
-    }
+    let (loops, loose) = boundary_loops(pattern);
+    let mut paths: Vec<Path2> = loops
+        .into_iter()
+        .map(|l| Path2 {
+            layer: "CUT",
+            points: l.iter().map(|&v| mm(pattern.vertices[v])).collect(),
+            closed: true,
+            panel: None,
+        })
+        .collect();
+    paths.extend(loose.into_iter().map(|[a, b]| Path2 {
+        layer: "CUT",
+        points: vec![mm(pattern.vertices[a]), mm(pattern.vertices[b])],
+        closed: false,
+        panel: None,
+    }));
     for h in &design.hinges {
         paths.push(Path2 {
             layer: if h.folds.valley >= h.folds.mountain {
@@ -114,14 +131,78 @@ pub fn plies(pattern: &Pattern, design: &ThickDesign) -> Vec<PlyDrawing> {
             },
             points: vec![mm(h.axis[0]), mm(h.axis[1])],
             closed: false,
+            panel: None,
         });
     }
     out.push(PlyDrawing {
         name: "hinge",
         paths,
         labels: Vec::new(),
+        circles: Vec::new(),
     });
     out
+}
+
+/// The sheet's outline: its boundary edges chained into closed loops of vertices, each
+/// walked as its facets walk it (the material on its left: the outer outline
+/// counter-clockwise, a hole's clockwise); at a vertex where two loops touch, the walk
+/// takes the sharpest left turn, so each loop stays simple. Boundary edges that no facet
+/// walks, or that close no loop, come back as loose segments.
+pub fn boundary_loops(pattern: &Pattern) -> (Vec<Vec<usize>>, Vec<[usize; 2]>) {
+    let mut walked = std::collections::HashSet::new();
+    for face in &pattern.faces {
+        for k in 0..face.len() {
+            walked.insert((face[k], face[(k + 1) % face.len()]));
+        }
+    }
+    let mut out_of: std::collections::HashMap<usize, Vec<usize>> = Default::default();
+    let mut loose = Vec::new();
+    for e in &pattern.edges {
+        if !matches!(e.kind, EdgeKind::Boundary) {
+            continue;
+        }
+        let [a, b] = e.v;
+        match (walked.contains(&(a, b)), walked.contains(&(b, a))) {
+            (true, false) => out_of.entry(a).or_default().push(b),
+            (false, true) => out_of.entry(b).or_default().push(a),
+            _ => loose.push([a, b]),
+        }
+    }
+    let v = |i: usize| pattern.vertices[i];
+    let turn = |from: usize, at: usize, to: usize| {
+        let (p, q, r) = (v(from), v(at), v(to));
+        let (u, w) = ([q[0] - p[0], q[1] - p[1]], [r[0] - q[0], r[1] - q[1]]);
+        (u[0] * w[1] - u[1] * w[0]).atan2(u[0] * w[0] + u[1] * w[1])
+    };
+    let mut loops = Vec::new();
+    let mut starts: Vec<usize> = out_of.keys().copied().collect();
+    starts.sort_unstable();
+    for start in starts {
+        while let Some(first) = out_of.get_mut(&start).and_then(Vec::pop) {
+            let mut lp = vec![start];
+            let (mut prev, mut at) = (start, first);
+            while at != start {
+                lp.push(at);
+                let Some(next) = out_of.get_mut(&at).filter(|n| !n.is_empty()) else {
+                    break;
+                };
+                let k = (0..next.len())
+                    .max_by(|&i, &j| turn(prev, at, next[i]).total_cmp(&turn(prev, at, next[j])))
+                    .unwrap_or(0);
+                let n = next.swap_remove(k);
+                (prev, at) = (at, n);
+            }
+            if at == start && lp.len() >= 3 {
+                loops.push(lp);
+            } else {
+                if at == start {
+                    lp.push(start);
+                }
+                loose.extend(lp.windows(2).map(|w| [w[0], w[1]]));
+            }
+        }
+    }
+    (loops, loose)
 }
 
 /// A panel's label: `P<facet>` at the outline's centroid, sized to fit.
@@ -151,11 +232,11 @@ fn io_err(path: &Path, e: impl std::fmt::Display) -> ExportError {
 /// Write one ply as DXF R12. R12 has no units variable (`$INSUNITS` came with R2000):
 /// coordinates are mm, which LightBurn, LaserGRBL and LibreCAD assume for a unitless file.
 pub fn write_dxf(path: &Path, ply: &PlyDrawing) -> Result<()> {
-    use dxf::entities::{Entity, EntityType, Line, Polyline, Text, Vertex};
+    use dxf::entities::{Circle, Entity, EntityType, Line, Polyline, Text, Vertex};
     use dxf::{Color, Drawing, Point, enums::AcadVersion, tables::Layer};
     let mut d = Drawing::new();
     d.header.version = AcadVersion::R12;
-    for (name, colour) in LAYERS.iter().zip([7u8, 3, 1, 5, 8]) {
+    for (name, colour) in LAYERS.iter().zip([7u8, 3, 1, 5, 8, 6]) {
         d.add_layer(Layer {
             name: (*name).into(),
             color: Color::from_index(colour),
@@ -178,6 +259,14 @@ pub fn write_dxf(path: &Path, ply: &PlyDrawing) -> Result<()> {
             Entity::new(EntityType::Polyline(poly))
         };
         e.common.layer = p.layer.into();
+        d.add_entity(e);
+    }
+    for (c, r) in &ply.circles {
+        let mut e = Entity::new(EntityType::Circle(Circle::new(
+            Point::new(c[0], c[1], 0.0),
+            *r,
+        )));
+        e.common.layer = "CUT".into();
         d.add_entity(e);
     }
     for (text, at, height) in &ply.labels {
@@ -248,6 +337,7 @@ pub fn write_svg(path: &Path, ply: &PlyDrawing) -> Result<()> {
         "SCORE" => "#00a000",
         "MOUNTAIN" => "#ff0000",
         "VALLEY" => "#0000ff",
+        "REGISTER" => "#ff00ff",
         _ => "#808080",
     };
     for layer in LAYERS {
@@ -265,6 +355,16 @@ pub fn write_svg(path: &Path, ply: &PlyDrawing) -> Result<()> {
             let tag = if p.closed { "polygon" } else { "polyline" };
             let _ = writeln!(s, r#"<{tag} points="{}"/>"#, pts.join(" "));
         }
+        if layer == "CUT" {
+            for (c, r) in &ply.circles {
+                let _ = writeln!(
+                    s,
+                    r#"<circle cx="{:.4}" cy="{:.4}" r="{r:.4}"/>"#,
+                    x(*c),
+                    y(*c)
+                );
+            }
+        }
         if layer == "LABEL" {
             for (text, at, height) in &ply.labels {
                 let _ = writeln!(
@@ -280,18 +380,4 @@ pub fn write_svg(path: &Path, ply: &PlyDrawing) -> Result<()> {
     }
     s.push_str("</svg>\n");
     super::write_file(path, s)
-}
-
-/// Write every ply of `design` into `dir` as `ply-<name>.dxf` and `ply-<name>.svg`.
-pub fn write_plies(dir: &Path, pattern: &Pattern, design: &ThickDesign) -> Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
-    for ply in plies(pattern, design) {
-        let dxf = dir.join(format!("ply-{}.dxf", ply.name));
-        write_dxf(&dxf, &ply)?;
-        let svg = dir.join(format!("ply-{}.svg", ply.name));
-        write_svg(&svg, &ply)?;
-        files.push(dxf);
-        files.push(svg);
-    }
-    Ok(files)
 }

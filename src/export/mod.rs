@@ -27,7 +27,9 @@
 //! assert!(files.fold.exists());
 //! ```
 
+pub mod fabrication_files;
 pub mod fold;
+pub mod laminate;
 pub mod laser;
 pub mod lzw;
 pub mod mesh;

@@ -12,6 +12,7 @@ use super::readback::read_at;
 use super::record::AlternativeRecord;
 use super::report::{report_design, row_design};
 use crate::check::robustness::RobustnessReport;
+use crate::export::fabrication_files::{self, Laid};
 use crate::export::report::{Fact, ReportDesign};
 use crate::export::{self, DesignMeta, ExportOptions};
 use crate::grammar::CreaseGraph;
@@ -63,7 +64,11 @@ pub(super) fn write_designs(
         let work = pool.install(|| {
             recs.par_iter()
                 .enumerate()
-                .map(|(k, rec)| build_design(task, plan, c * 256 + k + 1, rec, opts.sweep))
+                .map(|(k, rec)| {
+                    let rank = c * 256 + k + 1;
+                    let with_files = what(rank) == Written::All;
+                    build_design(task, plan, rank, rec, opts.sweep, with_files)
+                })
                 .collect::<Result<Vec<_>, _>>()
         })?;
         // Listed before they are written, so a kill leaves nothing unlisted: every
@@ -86,6 +91,9 @@ pub(super) fn write_designs(
             .collect();
         for (w, dir) in with_dir.into_iter().zip(out_dir.create_dirs(&dirs)?) {
             files.extend(export::planned_files(&dir, &w.pattern, &w.meta, &w.options).all());
+            if let Some(fab) = &w.fab {
+                files.extend(fabrication_files::planned(&dir, &fab.design, &STATES));
+            }
         }
         out_dir.register(&files)?;
         let written = pool.install(|| {
@@ -148,20 +156,41 @@ struct DesignWork {
     options: ExportOptions,
     /// The thick panels for the report's view and bill (`[fabrication]` only).
     thick: Option<serde_json::Value>,
+    /// The thick design's files to write (`[fabrication]`, designs with their folder).
+    fab: Option<FabWork>,
+}
+
+/// The states of a searched thick design's assemblies: flat, the middle of the dense
+/// sweep, its last state.
+const STATES: [&str; 3] = ["flat", "half", "folded"];
+
+/// A thick design's files to write into its folder: the panels, built on the checked
+/// pattern (the arm with its copies, on the search's dense sweep), their plies laid out.
+struct FabWork {
+    pattern: Pattern,
+    design: crate::fabricate::ThickDesign,
+    laid: Laid,
 }
 
 /// Rebuild the design of `rec` (ranked `rank`, from 1) and its `designs/<id>.json`
-/// (`sweep`: the search's dense sweep, on which a thick design's folds were measured).
+/// (`sweep`: the search's dense sweep, on which a thick design's folds were measured;
+/// `with_files`: it gets its folder, and a thick design its fabrication files there).
 fn build_design(
     task: &Task,
     plan: &Plan,
     rank: usize,
     rec: &AlternativeRecord,
     sweep: usize,
+    with_files: bool,
 ) -> Result<DesignWork, SearchError> {
     let (model, free, full, modes) = design_of(task, &plan.graph(task, rec.graph), rec)?;
     let design = Evaluated::new(&model.plan, full.clone(), modes);
-    let thick = thick_of(task, &model, &design, rec, sweep)?;
+    let mut thick = thick_of(task, &model, &design, rec, sweep)?;
+    let id = rec.id();
+    let fab = match thick.as_mut().filter(|_| with_files) {
+        Some(t) => Some(fab_work(task, &id, t)?),
+        None => None,
+    };
     let pattern = design.pattern(&sample_times(model.t_max, 33));
     let meta = design_meta(task, &model, rec);
     let all_vars: BTreeMap<String, f64> = model
@@ -181,7 +210,6 @@ fn build_design(
             })
             .collect()
     };
-    let id = rec.id();
     let doc = json!({
         "id": id,
         "task": task.name,
@@ -233,10 +261,34 @@ fn build_design(
         thick: thick
             .as_ref()
             .map(|t| crate::export::report::thick_json(&pattern, &t.design)),
+        fab,
         id,
         rank,
         pattern,
         meta,
+    })
+}
+
+/// A thick design's files for its folder `designs/<id>/`: its plies laid out with the
+/// task's laminate (a refusal names the `[fabrication]` field and the design), and the
+/// files listed in the design JSON's `fabrication.files` (relative to `designs/`).
+fn fab_work(task: &Task, id: &str, t: &mut ThickOf) -> Result<FabWork, SearchError> {
+    let laid = fabrication_files::lay_out(&t.pattern, &t.design, &task.laminate).map_err(
+        |(field, m)| {
+            SearchError::Export(format!(
+                "design {id}: [fabrication] {field}: {m} (the task's fabrication.{field})"
+            ))
+        },
+    )?;
+    let files: Vec<String> = fabrication_files::planned(Path::new(id), &t.design, &STATES)
+        .iter()
+        .map(|p| p.display().to_string().replace('\\', "/"))
+        .collect();
+    t.doc["files"] = json!(files);
+    Ok(FabWork {
+        pattern: t.pattern.clone(),
+        design: t.design.clone(),
+        laid,
     })
 }
 
@@ -324,6 +376,11 @@ fn write_design(
             let out = out_dir.path(&format!("designs/{id}"));
             let all = export::write_all(&out, &w.pattern, &w.meta, &w.options).map_err(err)?;
             let check = verified(&all.fold)?;
+            if let Some(fab) = &w.fab {
+                // The design JSON as the run's folder names it (the same on every machine).
+                let json = Path::new("designs").join(format!("{id}.json"));
+                write_fab(&out, &json, fab, &w.rec).map_err(err)?;
+            }
             (Some(all), Some(check))
         } else {
             // The other paths stay empty (the report links only what exists).
@@ -360,6 +417,35 @@ fn write_design(
     Ok(card)
 }
 
+/// Write a thick design's files into its folder `out` (as `foldsynth fabricate` writes
+/// them): `fabrication.json` records the design JSON (`json`, relative to the run's
+/// folder), that the material is the task's, and
+/// the search's thick check.
+fn write_fab(
+    out: &Path,
+    json: &Path,
+    fab: &FabWork,
+    rec: &AlternativeRecord,
+) -> export::Result<Vec<PathBuf>> {
+    let frames = &fab.pattern.frames;
+    let states: Vec<export::print::State<'_>> = STATES
+        .iter()
+        .map(|&s| {
+            let frame = match s {
+                "flat" => None,
+                "half" => frames.get(frames.len() / 2),
+                _ => frames.last(),
+            };
+            (s.to_string(), frame)
+        })
+        .collect();
+    let mut record = serde_json::Map::new();
+    record.insert("design".into(), json.display().to_string().into());
+    record.insert("material_from".into(), "task".into());
+    record.insert("check".into(), json!(rec.fabrication));
+    fabrication_files::write(out, &fab.pattern, &fab.design, &states, &fab.laid, record)
+}
+
 /// A design's thick panels (issue 32): the bill, the hinge axes and the check, for the
 /// design JSON and the report.
 pub(crate) struct ThickOf {
@@ -367,6 +453,8 @@ pub(crate) struct ThickOf {
     pub doc: serde_json::Value,
     /// The panels, built on the checked pattern (the arm with its copies).
     pub design: crate::fabricate::ThickDesign,
+    /// That pattern, on the search's dense sweep.
+    pub pattern: Pattern,
 }
 
 /// The thick panels of a kept design, rebuilt as the search built them (the same sweep,
@@ -400,10 +488,15 @@ fn thick_of(
         .collect();
     let doc = json!({
         "bill": built.bill(),
+        "laminate": task.laminate,
         "hinges": hinges,
         "check": rec.fabrication,
     });
-    Ok(Some(ThickOf { doc, design: built }))
+    Ok(Some(ThickOf {
+        doc,
+        design: built,
+        pattern: pat,
+    }))
 }
 
 /// The model of a record's graph and candidate, and the record's free variables, all

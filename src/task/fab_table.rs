@@ -9,10 +9,15 @@
 //! sides = "one"        # "one" or "both", default "one"
 //! hinge_gap = 0.5      # mm, default 0.5
 //! min_width = 2        # mm, default 2
+//! kerf = 0.15          # mm, default 0: cuts offset by half of it
+//! tab_width = 1        # mm, default 0: no tabs
+//! hole = 3             # mm, default 3: alignment-hole diameter
+//! sheet = "600x400"    # mm, default: the pattern's bounds plus a margin
 //! ```
 
 use super::fabrication::{
-    DEFAULT_HINGE_GAP_MM, DEFAULT_MIN_WIDTH_MM, FabMethod, Fabrication, Sides,
+    DEFAULT_HINGE_GAP_MM, DEFAULT_HOLE_MM, DEFAULT_MIN_WIDTH_MM, FabMethod, Fabrication, Laminate,
+    Sides,
 };
 use super::{Ctx, InitialGraph, Number, Robustness, TaskError, robustness::unit_length};
 use serde::Deserialize;
@@ -26,6 +31,10 @@ pub(crate) struct RawFabrication {
     sides: Option<String>,
     hinge_gap: Option<Number>,
     min_width: Option<Number>,
+    kerf: Option<Number>,
+    tab_width: Option<Number>,
+    hole: Option<Number>,
+    sheet: Option<String>,
 }
 
 /// One name out of `names`, or an error naming the field and listing them.
@@ -144,4 +153,31 @@ pub(crate) fn build(
         ));
     }
     Ok(Some(spec))
+}
+
+/// The laminate's layout from the table's optional `kerf`, `tab_width`, `hole` and `sheet`
+/// (the defaults without a table); errors name the field and what is allowed.
+pub(crate) fn laminate(cx: &Ctx<'_>, raw: Option<&RawFabrication>) -> Result<Laminate, TaskError> {
+    let Some(raw) = raw else {
+        return Ok(Laminate::default());
+    };
+    let optional = |field: &str, n: &Option<Number>, default: f64| match n {
+        Some(n) => cx.num(field, n),
+        None => Ok(default),
+    };
+    let sheet = match &raw.sheet {
+        Some(text) => {
+            Some(Laminate::parse_sheet(text).map_err(|m| cx.err("fabrication.sheet", m))?)
+        }
+        None => None,
+    };
+    let lam = Laminate {
+        kerf: optional("fabrication.kerf", &raw.kerf, 0.0)?,
+        tab_width: optional("fabrication.tab_width", &raw.tab_width, 0.0)?,
+        hole: optional("fabrication.hole", &raw.hole, DEFAULT_HOLE_MM)?,
+        sheet,
+    };
+    lam.validate()
+        .map_err(|(field, m)| cx.err(format!("fabrication.{field}"), m))?;
+    Ok(lam)
 }

@@ -151,6 +151,98 @@ impl Fabrication {
     }
 }
 
+/// Default alignment-hole diameter, mm.
+pub const DEFAULT_HOLE_MM: f64 = 3.0;
+
+/// How the plies of a laminate are laid out to be cut (issue 50): the laser's kerf, the
+/// tabs that hold each panel in its ply until the release cut, the alignment holes and the
+/// sheet. Lengths in mm. It changes no panel: only the drawings.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Laminate {
+    /// The laser's kerf, mm (finite, ≥ 0): every cut is offset by half of it so that the
+    /// part keeps its nominal size.
+    pub kerf: f64,
+    /// Width of the tabs (bridges) left in each panel's cut on the rigid plies, mm (0: no
+    /// tabs).
+    pub tab_width: f64,
+    /// Diameter of the alignment holes, mm (finite, > 0).
+    pub hole: f64,
+    /// The sheet, `[width, height]` mm; `None`: the pattern's bounds plus the margin.
+    pub sheet: Option<[f64; 2]>,
+}
+
+impl Default for Laminate {
+    fn default() -> Self {
+        Laminate {
+            kerf: 0.0,
+            tab_width: 0.0,
+            hole: DEFAULT_HOLE_MM,
+            sheet: None,
+        }
+    }
+}
+
+impl Laminate {
+    /// Check every value; `Err((field, what is allowed))` names the first bad one.
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
+        let within = |field: &'static str, v: f64, lo_open: bool| {
+            let ok =
+                v.is_finite() && v <= MAX_LENGTH_MM && if lo_open { v > 0.0 } else { v >= 0.0 };
+            if ok {
+                Ok(())
+            } else {
+                let lo = if lo_open { "(0" } else { "[0" };
+                Err((
+                    field,
+                    format!("must be a number of mm in {lo}, {MAX_LENGTH_MM}], got {v}"),
+                ))
+            }
+        };
+        within("kerf", self.kerf, false)?;
+        within("tab_width", self.tab_width, false)?;
+        within("hole", self.hole, true)?;
+        if self.hole <= self.kerf {
+            return Err((
+                "hole",
+                format!(
+                    "{} mm is not wider than the kerf {} mm: allowed a diameter above the kerf",
+                    self.hole, self.kerf
+                ),
+            ));
+        }
+        if let Some([w, h]) = self.sheet {
+            within("sheet", w, true)?;
+            within("sheet", h, true)?;
+        }
+        Ok(())
+    }
+
+    /// Read a sheet size `"WxH"` (mm, e.g. `"600x400"`); the message says what is allowed.
+    pub fn parse_sheet(text: &str) -> Result<[f64; 2], String> {
+        let bad = || {
+            format!(
+                "{:?} is not a sheet size: allowed \"WxH\", width and height in mm in (0, {MAX_LENGTH_MM}], e.g. \"600x400\"",
+                crate::text::excerpt(text, 40)
+            )
+        };
+        let (w, h) = text.trim().split_once(['x', 'X']).ok_or_else(bad)?;
+        let num = |s: &str| s.trim().parse::<f64>().ok();
+        match (num(w), num(h)) {
+            (Some(w), Some(h))
+                if w.is_finite()
+                    && h.is_finite()
+                    && w > 0.0
+                    && h > 0.0
+                    && w <= MAX_LENGTH_MM
+                    && h <= MAX_LENGTH_MM =>
+            {
+                Ok([w, h])
+            }
+            _ => Err(bad()),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -201,6 +293,29 @@ mod tests {
         }
         for name in FabMethod::NAMES {
             assert_eq!(FabMethod::from_name(name).unwrap().name(), name);
+        }
+    }
+
+    #[test]
+    fn laminate_values_and_sheets() {
+        assert!(Laminate::default().validate().is_ok());
+        let bad = Laminate {
+            kerf: -0.1,
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().unwrap_err().0, "kerf");
+        let bad = Laminate {
+            hole: 0.0,
+            ..Default::default()
+        };
+        assert_eq!(bad.validate().unwrap_err().0, "hole");
+        assert_eq!(Laminate::parse_sheet("600x400"), Ok([600.0, 400.0]));
+        assert_eq!(Laminate::parse_sheet(" 210.5 X 297 "), Ok([210.5, 297.0]));
+        for bad in ["axb", "600", "0x10", "-5x10", "infx3", ""] {
+            assert!(
+                Laminate::parse_sheet(bad).unwrap_err().contains("WxH"),
+                "{bad}"
+            );
         }
     }
 }

@@ -135,6 +135,9 @@ pub struct Task {
     /// optimizer then keeps the thick panels clear (see `docs/tasks.md`). `None` when absent:
     /// zero-thickness facets, as before.
     pub fabrication: Option<fabrication::Fabrication>,
+    /// `[fabrication]`'s `kerf`, `tab_width`, `hole` and `sheet`: how the plies are laid
+    /// out to be cut (issue 50); the defaults without the table.
+    pub laminate: fabrication::Laminate,
 }
 
 impl Task {

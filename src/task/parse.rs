@@ -160,6 +160,7 @@ impl<'a> Draft<'a> {
         let scene = scene(&cx, &raw, legacy, containment, &mut meshes)?;
         let robustness = robustness::build(&cx, raw.robustness.as_ref(), &initial)?;
         let fabrication = fab_table::build(&cx, raw.fabrication.as_ref(), &initial, &robustness)?;
+        let laminate = fab_table::laminate(&cx, raw.fabrication.as_ref())?;
 
         Ok(Task {
             name: name.trim().to_string(),
@@ -179,6 +180,7 @@ impl<'a> Draft<'a> {
             robustness,
             kawasaki: constraints::kawasaki(raw.constraints.as_ref()),
             fabrication,
+            laminate,
         })
     }
 }
