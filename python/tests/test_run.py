@@ -251,7 +251,7 @@ def test_export_counts_as_the_cli(run, task, tmp_path):
     assert ids == list(run.designs()["id"]) and len(ids) > 4
     designs = tmp_path / "three" / "designs"
     assert all((designs / f"{i}.fold").is_file() for i in ids)
-    assert all(len(list((designs / i).iterdir())) == 15 for i in ids[:3])
+    assert all(len(list((designs / i).iterdir())) == 17 for i in ids[:3])  # 15 + the print sheet (PDF, SVG)
     assert not any((designs / i).exists() for i in ids[3:])
     # report_motions=2 (--report-motions 2): the page draws the motion of the 2 most
     # robust designs, the folded form (one frame) of the others.
